@@ -1,0 +1,91 @@
+"""Discrete state-feedback controller of the rig: V = K s(t - tau), paper eqs. (13) and (26).
+
+Positions come from encoders (no velocities); velocities are estimated by a
+first-order low-pass filtered backward difference. The ROS controller node and the
+offline closed loop both use :class:`StateFeedback`, so they compute the same commands.
+"""
+from __future__ import annotations
+
+import math
+from collections import deque
+
+
+def delay_samples(tau: float, dt: float) -> int:
+    """Number of samples n with tau = n dt; raises ValueError if tau is not a multiple."""
+    if not math.isfinite(tau) or tau < 0:
+        raise ValueError(f'delay tau = {tau!r} s: must be finite and >= 0')
+    n = round(tau / dt)
+    if abs(n * dt - tau) > 1e-9 * max(1.0, tau) + 1e-12:
+        raise ValueError(f'delay tau = {tau:g} s is not a multiple of the sample period '
+                         f'{dt:g} s; allowed: n * {dt:g} s, e.g. {n * dt:g} s')
+    return n
+
+
+class StateFeedback:
+    """V_k = sat(K . (x, theta, x', theta')_{k-n}) with n = tau / dt.
+
+    Parameters
+    ----------
+    gain : sequence of 4 (a 5th, z entry must be 0: z is not measured) [V/m, V/rad, V s/m, V s/rad]
+    dt : sample period [s]
+    delay : artificial feedback delay tau [s], a multiple of dt
+    cutoff_hz : corner frequency of the velocity filter [Hz]; 0 = raw backward difference
+    voltage_limit : |V| bound [V] (inf = none)
+
+    Before the first sample the state is taken as constant at the first measurement
+    with zero velocity, the history of paper eq. (30).
+    """
+
+    def __init__(self, gain, dt: float, delay: float = 0.0, cutoff_hz: float = 50.0,
+                 voltage_limit: float = math.inf):
+        gain = [float(k) for k in gain]
+        if len(gain) == 5 and gain[4] != 0.0:
+            raise ValueError('gain[4] (z): the bristle state is not measured; it must be 0')
+        if len(gain) not in (4, 5) or not all(math.isfinite(k) for k in gain):
+            raise ValueError(f'gain: expected 4 finite numbers (x, theta, x\', theta\'), got {gain}')
+        if not dt > 0:
+            raise ValueError(f'dt = {dt!r}: must be > 0')
+        self.gain = gain[:4]
+        self.dt = dt
+        self.cutoff_hz = float(cutoff_hz)
+        self.voltage_limit = float(voltage_limit)
+        self.set_delay(delay)
+        self._last = None
+        self._vel = [0.0, 0.0]
+
+    def set_delay(self, tau: float) -> None:
+        """Change tau [s] (a multiple of dt); the history keeps what it has."""
+        n = delay_samples(tau, self.dt)
+        self.delay = tau
+        old = list(getattr(self, '_history', []))
+        self._history = deque(old[-(n + 1):], maxlen=n + 1)
+        if old:
+            while len(self._history) < n + 1:
+                self._history.appendleft(self._history[0])
+
+    def _filter_coefficient(self) -> float:
+        if self.cutoff_hz <= 0:
+            return 0.0
+        return math.exp(-2 * math.pi * self.cutoff_hz * self.dt)
+
+    def estimate(self, x: float, theta: float) -> tuple[float, float, float, float]:
+        """Push one measurement; return the current state estimate."""
+        if self._last is None:
+            self._last = (x, theta)
+            return (x, theta, 0.0, 0.0)
+        a = self._filter_coefficient()
+        raw = ((x - self._last[0]) / self.dt, (theta - self._last[1]) / self.dt)
+        self._vel = [a * v + (1 - a) * r for v, r in zip(self._vel, raw)]
+        self._last = (x, theta)
+        return (x, theta, self._vel[0], self._vel[1])
+
+    def update(self, x: float, theta: float) -> float:
+        """Voltage [V] for the sample whose encoder readings are ``x`` [m], ``theta`` [rad]."""
+        est = self.estimate(x, theta)
+        if not self._history:
+            self._history.extend([est] * self._history.maxlen)
+        else:
+            self._history.append(est)
+        used = self._history[0]
+        v = sum(k * s for k, s in zip(self.gain, used))
+        return max(-self.voltage_limit, min(self.voltage_limit, v))

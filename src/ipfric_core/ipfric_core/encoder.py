@@ -1,0 +1,17 @@
+"""Incremental-encoder measurement: positions rounded to whole counts (paper section 6).
+
+Paper resolutions: angle 0.08789 deg (4096 counts/rev), cart 0.00454 cm.
+"""
+from __future__ import annotations
+
+import math
+
+ANGLE_RESOLUTION_RAD = math.radians(0.08789)
+CART_RESOLUTION_M = 0.00454e-2
+
+
+def quantize(value: float, resolution: float) -> float:
+    """``value`` rounded to the nearest multiple of ``resolution`` (0 disables)."""
+    if resolution <= 0.0:
+        return value
+    return resolution * round(value / resolution)

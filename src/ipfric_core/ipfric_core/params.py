@@ -1,0 +1,192 @@
+"""Typed, validated parameters of the cart-pendulum and its friction (paper Tables 1-4).
+
+Every field has a unit, a type and an allowed range; loading a YAML mapping that
+violates any of them raises :class:`ConfigError` naming the field (dotted path),
+the value and what is allowed.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any, Mapping
+
+import yaml
+
+FRICTION_MODELS = ('viscous', 'coulomb', 'exponential', 'dynamic')
+SMOOTHING = ('none', 'tanh')
+
+
+class ConfigError(ValueError):
+    """A configuration value is missing, of the wrong type or out of range."""
+
+
+@dataclass(frozen=True)
+class Field:
+    """Schema of one numeric field: unit, open/closed range and description."""
+
+    unit: str
+    lo: float
+    hi: float
+    doc: str
+    lo_open: bool = False
+    integer: bool = False
+
+    def describe(self) -> str:
+        left = '(' if self.lo_open else '['
+        return f'{left}{self.lo:g}, {self.hi:g}] {self.unit}'.rstrip()
+
+
+def _check_number(path: str, value: Any, spec: Field) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ConfigError(f'{path}: expected a number in {spec.describe()} ({spec.doc}), '
+                          f'got {type(value).__name__} {value!r}')
+    if spec.integer and int(value) != value:
+        raise ConfigError(f'{path}: expected an integer in {spec.describe()}, got {value!r}')
+    v = float(value)
+    if not math.isfinite(v):
+        raise ConfigError(f'{path}: {value!r} is not finite; allowed {spec.describe()}')
+    too_low = v <= spec.lo if spec.lo_open else v < spec.lo
+    if too_low or v > spec.hi:
+        raise ConfigError(f'{path}: {v:g} is out of range; allowed {spec.describe()} ({spec.doc})')
+    return v
+
+
+def check_choice(path: str, value: Any, allowed: tuple[str, ...]) -> str:
+    """Return ``value`` if it is one of ``allowed``, else raise naming the field."""
+    if not isinstance(value, str) or value not in allowed:
+        raise ConfigError(f'{path}: {value!r} is not one of {", ".join(allowed)}')
+    return value
+
+
+def _check_keys(path: str, data: Any, known: set[str], required: set[str]) -> Mapping:
+    if not isinstance(data, Mapping):
+        raise ConfigError(f'{path}: expected a mapping, got {type(data).__name__}')
+    unknown = set(data) - known
+    if unknown:
+        raise ConfigError(f'{path}: unknown field(s) {", ".join(sorted(map(str, unknown)))}; '
+                          f'allowed: {", ".join(sorted(known))}')
+    missing = required - set(data)
+    if missing:
+        raise ConfigError(f'{path}: missing field(s) {", ".join(sorted(missing))}')
+    return data
+
+
+PLANT_FIELDS = {
+    'M': Field('kg', 0.0, 1e3, 'cart mass', lo_open=True),
+    'm': Field('kg', 0.0, 1e3, 'pendulum mass', lo_open=True),
+    'l': Field('m', 0.0, 10.0, 'pivot to pendulum centre of mass', lo_open=True),
+    'g': Field('m/s^2', 0.0, 100.0, 'gravity', lo_open=True),
+    'alpha': Field('N/V', 0.0, 1e3, 'motor voltage-to-force factor, eq. (2)', lo_open=True),
+    'beta': Field('N s/m', 0.0, 1e3, 'motor back-EMF damping, eq. (2)'),
+}
+
+
+@dataclass(frozen=True)
+class PlantParams:
+    """Cart-pendulum of paper Table 1 (SI units)."""
+
+    M: float = 0.815
+    m: float = 0.210
+    l: float = 0.3050
+    g: float = 9.8
+    alpha: float = 1.7189
+    beta: float = 7.682
+
+    @classmethod
+    def from_dict(cls, data: Any, path: str = 'plant') -> 'PlantParams':
+        data = _check_keys(path, data, set(PLANT_FIELDS), set(PLANT_FIELDS))
+        return cls(**{k: _check_number(f'{path}.{k}', data[k], s) for k, s in PLANT_FIELDS.items()})
+
+    @property
+    def normal_force(self) -> float:
+        """F_N = (M + m) g [N], the paper's normal force with the pendulum attached."""
+        return (self.M + self.m) * self.g
+
+
+FRICTION_FIELDS = {
+    'eps': Field('N s/m', 0.0, 1e3, 'viscous coefficient, eq. (3)/(7)'),
+    'mu_s': Field('', 0.0, 2.0, 'static friction coefficient, eq. (5)'),
+    'mu_c': Field('', 0.0, 2.0, 'Coulomb friction coefficient, eq. (6)'),
+    'v_s': Field('m/s', 0.0, 100.0, 'Stribeck velocity, eq. (8)', lo_open=True),
+    'gamma': Field('', 0.0, 10.0, 'Stribeck form factor, eq. (8)', lo_open=True),
+    'sigma0': Field('N/m', 0.0, 1e9, 'bristle stiffness, eq. (10)', lo_open=True),
+    'sigma1': Field('N s/m', 0.0, 1e6, 'bristle damping, eq. (11)'),
+    'delta': Field('s/m', 0.0, 1e6, 'slope of the tanh(delta v) smoothing of sgn(v)', lo_open=True),
+}
+# Fields each model needs (besides 'model' and 'smoothing').
+FRICTION_REQUIRED = {
+    'viscous': {'eps'},
+    'coulomb': {'eps', 'mu_s', 'mu_c'},
+    'exponential': {'eps', 'mu_s', 'mu_c', 'v_s', 'gamma'},
+    'dynamic': {'eps', 'mu_s', 'mu_c', 'v_s', 'gamma', 'sigma0', 'sigma1'},
+}
+
+
+@dataclass(frozen=True)
+class FrictionParams:
+    """Cart-track friction: model name and coefficients (paper Tables 2-4, eq. 9).
+
+    ``smoothing='tanh'`` replaces sgn(v) by tanh(delta v) (no sticking phase); with
+    ``'none'`` the coulomb and exponential models stick exactly. ``delta`` is also
+    the slope used to linearize a sticking model (paper section 3.1).
+    """
+
+    model: str = 'viscous'
+    eps: float = 2.1
+    mu_s: float = 0.0
+    mu_c: float = 0.0
+    v_s: float = 0.105
+    gamma: float = 2.0
+    sigma0: float = 121.0
+    sigma1: float = 70.0
+    smoothing: str = 'none'
+    delta: float = 100.0
+
+    @classmethod
+    def from_dict(cls, data: Any, path: str = 'friction') -> 'FrictionParams':
+        if not isinstance(data, Mapping):
+            raise ConfigError(f'{path}: expected a mapping, got {type(data).__name__}')
+        model = check_choice(f'{path}.model', data.get('model'), FRICTION_MODELS)
+        known = set(FRICTION_FIELDS) | {'model', 'smoothing'}
+        _check_keys(path, data, known, FRICTION_REQUIRED[model] | {'model'})
+        values = {k: _check_number(f'{path}.{k}', data[k], s)
+                  for k, s in FRICTION_FIELDS.items() if k in data}
+        smoothing = check_choice(f'{path}.smoothing', data.get('smoothing', 'none'), SMOOTHING)
+        if smoothing == 'tanh' and model not in ('coulomb', 'exponential'):
+            raise ConfigError(f'{path}.smoothing: tanh applies to the coulomb and exponential '
+                              f'models, not {model!r}; use none')
+        if model != 'viscous' and values.get('mu_c', 0.0) > values.get('mu_s', 0.0):
+            raise ConfigError(f'{path}.mu_c: {values["mu_c"]:g} exceeds mu_s = {values["mu_s"]:g}; '
+                              f'allowed 0 <= mu_c <= mu_s')
+        return cls(model=model, smoothing=smoothing, **values)
+
+    def to_dict(self) -> dict:
+        """Only the fields the model uses, in YAML-ready form."""
+        keep = FRICTION_REQUIRED[self.model] | {'model'}
+        if self.model in ('coulomb', 'exponential'):
+            keep |= {'smoothing', 'delta'}
+        return {k: v for k, v in asdict(self).items() if k in keep}
+
+    def replace(self, **changes) -> 'FrictionParams':
+        data = asdict(self)
+        data.update(changes)
+        return FrictionParams(**data)
+
+
+def load_yaml(path: str | Path) -> Any:
+    """Parse a YAML file, turning syntax errors into ConfigError with the location."""
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise ConfigError(f'{path}: cannot read ({exc.strerror})') from exc
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, 'problem_mark', None)
+        where = f' line {mark.line + 1} column {mark.column + 1}' if mark else ''
+        raise ConfigError(f'{path}:{where} malformed YAML: {getattr(exc, "problem", exc)}') from exc
+    if not isinstance(data, Mapping):
+        raise ConfigError(f'{path}: expected a mapping at top level, got {type(data).__name__}')
+    return data

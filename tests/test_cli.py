@@ -1,0 +1,39 @@
+"""`./ipfric design --json` and `./ipfric stability --json` print ipfric's and the paper's numbers."""
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def cli(*args):
+    out = subprocess.run([sys.executable, '-m', 'ipfric_core.cli', *args], capture_output=True, text=True,
+                         cwd=ROOT, env={'PYTHONPATH': str(ROOT / 'src' / 'ipfric_core'), 'PATH': '/usr/bin:/bin'})
+    return out
+
+
+def test_design_json_side_by_side():
+    out = cli('design', '--json')
+    assert out.returncode == 0, out.stderr
+    rep = json.loads(out.stdout)
+    for name in ('viscous', 'exponential', 'dynamic'):
+        assert rep['gains'][name]['max_rel_diff'] < 3e-5
+    assert round(rep['friction_estimates']['mu_s']['ipfric'], 5) == 0.08328
+    assert rep['controllability_rank']['dynamic'] == {'rank': 4, 'n_states': 5}
+
+
+def test_stability_json_side_by_side():
+    out = cli('stability', '--json')
+    rep = json.loads(out.stdout)
+    assert round(rep['routh_hurwitz_gain_15_exponential']['unstable_above_delta']['ipfric'], 1) == 60.4
+    assert abs(rep['critical_delay_s']['exponential']['ipfric'] - 0.1069) < 5e-5
+    assert rep['critical_delay_s']['dynamic']['paper'] == 0.1169
+
+
+def test_bad_config_is_a_clear_error(tmp_path):
+    bad = tmp_path / 'p.yaml'
+    bad.write_text((ROOT / 'config' / 'paper.yaml').read_text().replace('model: dynamic', 'model: bristle'))
+    out = cli('design', '--config', str(bad))
+    assert out.returncode == 2
+    assert "friction.dynamic.model: 'bristle' is not one of viscous, coulomb, exponential, dynamic" in out.stderr
