@@ -9,14 +9,15 @@ from ipfric_core.closedloop import run_closed_loop
 from ipfric_core.controller import StateFeedback, delay_samples
 from ipfric_core.encoder import ANGLE_RESOLUTION_RAD, CART_RESOLUTION_M, quantize
 from ipfric_core.plant import CartPendulum
-from ipfric_core.simulate import Simulator
+from ipfric_core.rig import PlantTruth, Rig
 
 PAPER_RES = (CART_RESOLUTION_M, ANGLE_RESOLUTION_RAD)
 
 
 def run(cfg, friction, gain, theta0, duration=30.0, res=(0.0, 0.0), delay=0.0):
-    sim = Simulator(CartPendulum(cfg.plant, cfg.friction[friction]), [0.0, theta0, 0.0, 0.0])
-    return run_closed_loop(sim, StateFeedback(gain, 1e-3, delay), duration, res)
+    rig = Rig(CartPendulum(cfg.plant, cfg.friction[friction]), PlantTruth(), [0.0, theta0, 0.0, 0.0],
+              1e-3, res)
+    return run_closed_loop(rig, StateFeedback(gain, 1e-3, delay), duration)
 
 
 def test_old_gain_on_stick_slip_plant_oscillates(paper_cfg):
@@ -49,7 +50,7 @@ def test_quantization_leaves_small_oscillation(paper_cfg):
 
 def test_large_delay_makes_the_pendulum_fall(paper_cfg):
     tr = run(paper_cfg, 'exponential', paper.GAIN_23_EXPONENTIAL, math.radians(3), duration=10, delay=0.06)
-    assert tr.end_reason == 'fallen'
+    assert tr.end_reason == 'FALLEN'
 
 
 def test_delay_is_exact_in_samples():

@@ -4,7 +4,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from .params import ConfigError, FrictionParams, PlantParams, _check_keys, _check_number, Field, load_yaml
+from .params import ConfigError, FrictionParams, PlantParams, check_keys, check_number, Field, load_yaml
 
 REPO_ROOT = Path(__file__).resolve().parents[3]
 DEFAULT_CONFIG = REPO_ROOT / 'config' / 'paper.yaml'
@@ -24,7 +24,7 @@ class PaperConfig:
 def load_paper_config(path: str | Path = DEFAULT_CONFIG) -> PaperConfig:
     """Load and validate ``config/paper.yaml``; errors name the offending field."""
     data = load_yaml(path)
-    _check_keys(str(path), data, {'plant', 'friction', 'design'}, {'plant', 'friction', 'design'})
+    check_keys(str(path), data, {'plant', 'friction', 'design'}, {'plant', 'friction', 'design'})
     plant = PlantParams.from_dict(data['plant'])
     fr = data['friction']
     if not isinstance(fr, dict) or not fr:
@@ -34,10 +34,10 @@ def load_paper_config(path: str | Path = DEFAULT_CONFIG) -> PaperConfig:
         if needed not in friction:
             raise ConfigError(f'friction.{needed}: missing; the paper report needs viscous, '
                               f'exponential and dynamic')
-    des = _check_keys('design', data['design'], {'Q', 'R'}, {'Q', 'R'})
+    des = check_keys('design', data['design'], {'Q', 'R'}, {'Q', 'R'})
     Q = des['Q']
     if not isinstance(Q, list) or len(Q) != 4:
         raise ConfigError(f'design.Q: expected 4 weights on (x, theta, x\', theta\'), got {Q!r}')
-    Q = tuple(_check_number(f'design.Q[{i}]', q, WEIGHT) for i, q in enumerate(Q))
-    R = _check_number('design.R', des['R'], Field('', 0.0, 1e12, 'control weight', lo_open=True))
+    Q = tuple(check_number(f'design.Q[{i}]', q, WEIGHT) for i, q in enumerate(Q))
+    R = check_number('design.R', des['R'], Field('', 0.0, 1e12, 'control weight', lo_open=True))
     return PaperConfig(plant, friction, Q, R)

@@ -37,7 +37,7 @@ class Field:
         return f'{left}{self.lo:g}, {self.hi:g}] {self.unit}'.rstrip()
 
 
-def _check_number(path: str, value: Any, spec: Field) -> float:
+def check_number(path: str, value: Any, spec: Field) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ConfigError(f'{path}: expected a number in {spec.describe()} ({spec.doc}), '
                           f'got {type(value).__name__} {value!r}')
@@ -59,7 +59,7 @@ def check_choice(path: str, value: Any, allowed: tuple[str, ...]) -> str:
     return value
 
 
-def _check_keys(path: str, data: Any, known: set[str], required: set[str]) -> Mapping:
+def check_keys(path: str, data: Any, known: set[str], required: set[str]) -> Mapping:
     if not isinstance(data, Mapping):
         raise ConfigError(f'{path}: expected a mapping, got {type(data).__name__}')
     unknown = set(data) - known
@@ -95,8 +95,8 @@ class PlantParams:
 
     @classmethod
     def from_dict(cls, data: Any, path: str = 'plant') -> 'PlantParams':
-        data = _check_keys(path, data, set(PLANT_FIELDS), set(PLANT_FIELDS))
-        return cls(**{k: _check_number(f'{path}.{k}', data[k], s) for k, s in PLANT_FIELDS.items()})
+        data = check_keys(path, data, set(PLANT_FIELDS), set(PLANT_FIELDS))
+        return cls(**{k: check_number(f'{path}.{k}', data[k], s) for k, s in PLANT_FIELDS.items()})
 
     @property
     def normal_force(self) -> float:
@@ -149,8 +149,8 @@ class FrictionParams:
             raise ConfigError(f'{path}: expected a mapping, got {type(data).__name__}')
         model = check_choice(f'{path}.model', data.get('model'), FRICTION_MODELS)
         known = set(FRICTION_FIELDS) | {'model', 'smoothing'}
-        _check_keys(path, data, known, FRICTION_REQUIRED[model] | {'model'})
-        values = {k: _check_number(f'{path}.{k}', data[k], s)
+        check_keys(path, data, known, FRICTION_REQUIRED[model] | {'model'})
+        values = {k: check_number(f'{path}.{k}', data[k], s)
                   for k, s in FRICTION_FIELDS.items() if k in data}
         smoothing = check_choice(f'{path}.smoothing', data.get('smoothing', 'none'), SMOOTHING)
         if smoothing == 'tanh' and model not in ('coulomb', 'exponential'):
