@@ -80,6 +80,19 @@ def cmd_stability(args) -> int:
     return 0
 
 
+def cmd_demo(args) -> int:
+    """The README's main job: the paper's design and stability report."""
+    if args.json:
+        from .reports import design_report, stability_report
+        cfg = load_paper_config(args.config)
+        _print_json({'design': design_report(cfg, Path(args.data) / 'paper'),
+                     'stability': stability_report(cfg)})
+        return 0
+    rc = cmd_design(args)
+    print()
+    return rc or cmd_stability(args)
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog='ipfric', description='Friction and the inverted pendulum: '
                                 'design, simulation, ROS 2 closed loop and analysis.')
@@ -97,6 +110,9 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument('--data', default=str(DEFAULT_DATA), help='shared data directory (default %(default)s)')
     s = add('stability', cmd_stability, 'Routh-Hurwitz thresholds in delta and critical delays tau_c')
     s.add_argument('--config', default=str(DEFAULT_CONFIG), help='paper parameter YAML (default %(default)s)')
+    m = add('demo', cmd_demo, 'the main job on the default configuration: design and stability report')
+    m.add_argument('--config', default=str(DEFAULT_CONFIG), help='paper parameter YAML (default %(default)s)')
+    m.add_argument('--data', default=str(DEFAULT_DATA), help='shared data directory (default %(default)s)')
     return p
 
 
