@@ -36,7 +36,7 @@ class StateFeedback:
     with zero velocity, the history of paper eq. (30).
     """
 
-    def __init__(self, gain, dt: float, delay: float = 0.0, cutoff_hz: float = 50.0,
+    def __init__(self, gain, dt: float, delay: float = 0.0, cutoff_hz: float = 20.0,
                  voltage_limit: float = math.inf):
         gain = [float(k) for k in gain]
         if len(gain) == 5 and gain[4] != 0.0:

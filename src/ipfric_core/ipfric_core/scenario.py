@@ -24,7 +24,7 @@ The file is an ordinary ``--params-file`` YAML::
         gain_source: yaml        # yaml | design
         gain: [70.7107, 142.5409, 50.6911, 26.9817]
         delay: 0.0               # [s] artificial feedback delay tau, eq. (26)
-        cutoff_hz: 50.0          # [Hz] velocity filter
+        cutoff_hz: 20.0          # [Hz] velocity filter
         voltage_limit: 10.0      # [V]
         plant: {...}             # used when gain_source = design
         design_friction: {...}
@@ -84,7 +84,7 @@ TRUTH_FIELDS = {
 CONTROLLER_FIELDS = {
     'sample_rate_hz': (1000.0, SIM_FIELDS['sample_rate_hz'][1]),
     'delay': (0.0, Field('s', 0.0, 10.0, 'artificial feedback delay tau, eq. (26), a multiple of the sample period')),
-    'cutoff_hz': (50.0, Field('Hz', 0.0, 1e4, 'velocity filter corner (0 = raw difference)')),
+    'cutoff_hz': (20.0, Field('Hz', 0.0, 1e4, 'velocity filter corner (0 = raw difference)')),
     'voltage_limit': (10.0, Field('V', 0.0, 1e3, 'command saturation', lo_open=True)),
     'R': (1.0, Field('', 0.0, 1e12, 'LQR control weight', lo_open=True)),
 }
@@ -114,7 +114,7 @@ class ControllerSettings:
     gain_source: str = 'yaml'
     gain: tuple | None = None
     delay: float = 0.0
-    cutoff_hz: float = 50.0
+    cutoff_hz: float = 20.0
     voltage_limit: float = 10.0
     plant: PlantParams = PlantParams()
     design_friction: FrictionParams | None = None
