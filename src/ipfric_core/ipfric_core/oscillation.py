@@ -19,8 +19,8 @@ class Oscillation:
     """Result of :func:`classify`.
 
     cls : one of CLASSES
-    transition_time : s; when the final regime starts (settling time, onset of the
-        cycle, or the fall)
+    transition_time : s; when the final regime starts (entry into the settled band,
+        onset of the cycle, or the fall); None while still converging
     x_p2p, theta_p2p : peak-to-peak over the analysis window [m], [rad]
     period_crossings, period_spectrum : s, two independent estimates (None if no cycle)
     frequency : Hz, from the zero-crossing period
@@ -75,11 +75,13 @@ def classify(t, x, theta, resolution=(4.54e-5, 1.534e-3), fallen_angle: float = 
     """Classify a run from its samples.
 
     Settled: over the last ``window`` seconds both signals stay inside a band of
-    2 encoder counts (``resolution`` = (cart [m], angle [rad]); at least 1e-6) about
+    2 encoder counts (``resolution`` = (cart [m], angle [rad]); a count is taken as at
+    least 5e-5, so exact sensors settle inside 0.1 mm and 0.006 deg) about
     their mean.
-    Limit cycle: larger, with the peak-to-peak of the last window within 25 % of the
-    window before it. Growing: the last window's amplitude exceeds the previous by
-    more than 25 %. Fallen: |theta| reached ``fallen_angle``, or the run ended on a
+    The larger of the two signals (in counts) then decides: growing if the second half
+    of the window has over 1.25 times the peak-to-peak of the first; settled (still
+    converging) if it has under half, or if the signal does not cross its mean twice
+    (a creep, not an oscillation); otherwise a limit cycle. Fallen: |theta| reached ``fallen_angle``, or the run ended on a
     safety limit (``ended_fallen``: the pendulum fell or the cart hit the track end).
     """
     t, x, theta = (np.asarray(a, float) for a in (t, x, theta))
@@ -93,20 +95,26 @@ def classify(t, x, theta, resolution=(4.54e-5, 1.534e-3), fallen_angle: float = 
     xp, thp = float(np.ptp(xs)), float(np.ptp(ths))
     steps = np.diff(xs) == 0.0
     stick = float(steps.mean()) if len(steps) else 0.0
-    band_x, band_th = 2 * max(resolution[0], 1e-6), 2 * max(resolution[1], 1e-6)
+    band_x, band_th = 2 * max(resolution[0], 5e-5), 2 * max(resolution[1], 5e-5)
     if xp <= band_x and thp <= band_th:
         outside = (np.abs(x - xs.mean()) > band_x) | (np.abs(theta - ths.mean()) > band_th)
         last = np.nonzero(outside)[0]
         tt = float(t[last[-1] + 1]) if len(last) and last[-1] + 1 < len(t) else float(t[0])
         return Oscillation('settled', tt, xp, thp, None, None, None, stick, (float(ts[0]), float(ts[-1])))
-    prev = (t >= t[-1] - 2 * window) & ~w
-    grow = xp > 1.25 * float(np.ptp(x[prev])) if prev.sum() > 1 else False
     signal = ths if thp / band_th >= xp / band_x else xs
+    half = len(signal) // 2
+    first, second = float(np.ptp(signal[:half])), float(np.ptp(signal[half:]))
     pc, ps = crossing_period(ts, signal), spectral_period(ts, signal)
-    cls = 'growing' if grow else 'limit_cycle'
+    window_span = (float(ts[0]), float(ts[-1]))
+    if second > 1.25 * first:
+        cls = 'growing'
+    elif second < 0.5 * first or pc is None:
+        # decaying, or a creep without oscillation: converging to rest
+        return Oscillation('settled', None, xp, thp, None, None, None, stick, window_span)
+    else:
+        cls = 'limit_cycle'
     onset = _onset(t, x, 0.5 * xp, 1.5 * (pc or ps or 1.0))
-    return Oscillation(cls, onset, xp, thp, pc, ps, 1.0 / pc if pc else None, stick,
-                       (float(ts[0]), float(ts[-1])))
+    return Oscillation(cls, onset, xp, thp, pc, ps, 1.0 / pc if pc else None, stick, window_span)
 
 
 def _onset(t, x, half_p2p, span) -> float:

@@ -1,0 +1,139 @@
+"""Stability maps over the artificial delay tau and the initial angle theta0 (Figures 11-12).
+
+Each cell is one closed-loop run of a scenario with the controller delay and theta0
+replaced, classified by :func:`ipfric_core.oscillation.classify`. Cells run in parallel
+processes, are appended to ``cells.csv`` as they finish (so an interrupted sweep resumes
+without redoing them), and are deterministic: a cell's result depends only on its inputs.
+"""
+from __future__ import annotations
+
+import csv
+import math
+import os
+import sys
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import replace
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from .closedloop import run_closed_loop
+from .oscillation import CLASSES, classify
+from .scenario import Scenario
+
+FIELDS = ('tau_s', 'theta0_deg', 'class', 'transition_time_s', 'x_p2p_m', 'theta_p2p_rad', 'period_s')
+
+
+def cell_scenario(base: Scenario, tau: float, theta0_deg: float) -> Scenario:
+    """``base`` with the feedback delay tau [s] and initial angle theta0 [deg]."""
+    return replace(base, sim=replace(base.sim, theta0=math.radians(theta0_deg)),
+                   controller=replace(base.controller, delay=tau))
+
+
+def run_cell(base: Scenario, tau: float, theta0_deg: float, duration: float) -> dict:
+    """Run and classify one cell; returns a CSV row."""
+    scn = cell_scenario(base, tau, theta0_deg)
+    tr = run_closed_loop(scn.make_rig(), scn.make_controller(), duration)
+    o = classify(tr.t, tr.measured[:, 0], tr.measured[:, 1], (scn.sim.cart_resolution, scn.sim.angle_resolution),
+                 scn.sim.fallen_angle, ended_fallen=tr.end_reason != 'duration')
+    return {'tau_s': round(tau, 9), 'theta0_deg': round(theta0_deg, 9), 'class': o.cls,
+            'transition_time_s': o.transition_time, 'x_p2p_m': o.x_p2p, 'theta_p2p_rad': o.theta_p2p,
+            'period_s': o.period_crossings}
+
+
+def _key(tau, theta0_deg) -> tuple:
+    return (round(float(tau), 9), round(float(theta0_deg), 9))
+
+
+def load_cells(path: Path) -> dict:
+    """Finished cells of an earlier (possibly interrupted) sweep; a torn last line is ignored."""
+    done = {}
+    if not path.exists():
+        return done
+    with open(path, newline='') as fh:
+        for row in csv.DictReader(fh):
+            try:
+                if row['class'] not in CLASSES:
+                    continue
+                typed = {k: (None if row[k] in ('', None) else float(row[k])) for k in FIELDS if k != 'class'}
+                typed['class'] = row['class']
+                done[_key(typed['tau_s'], typed['theta0_deg'])] = typed
+            except (KeyError, TypeError, ValueError):
+                continue
+    return done
+
+
+def sweep(base: Scenario, taus, thetas_deg, duration: float, out_dir: str | Path,
+          workers: int | None = None, progress: Callable[[int, int], None] | None = None) -> list[dict]:
+    """Run every (tau, theta0) cell not already in ``out_dir/cells.csv``; return all rows sorted."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / 'cells.csv'
+    done = load_cells(path)
+    todo = [(t, th) for th in thetas_deg for t in taus if _key(t, th) not in done]
+    total = len(taus) * len(thetas_deg)
+    new_file = not path.exists() or not done
+    with open(path, 'w' if new_file else 'a', newline='') as fh:
+        w = csv.DictWriter(fh, FIELDS)
+        if new_file:
+            w.writeheader()
+        finished = total - len(todo)
+        if progress:
+            progress(finished, total)
+        with ProcessPoolExecutor(max_workers=workers or os.cpu_count()) as pool:
+            futures = [pool.submit(run_cell, base, t, th, duration) for t, th in todo]
+            for fut in as_completed(futures):
+                row = fut.result()
+                w.writerow(row)
+                fh.flush()
+                done[_key(row['tau_s'], row['theta0_deg'])] = row
+                finished += 1
+                if progress:
+                    progress(finished, total)
+    rows = [done[_key(t, th)] for th in thetas_deg for t in taus]
+    with open(path, 'w', newline='') as fh:  # rewrite in grid order: same inputs, same file
+        w = csv.DictWriter(fh, FIELDS)
+        w.writeheader()
+        w.writerows(rows)
+    return rows
+
+
+def grid(rows, taus, thetas_deg) -> list[list[str]]:
+    """Classes as a theta0-by-tau table."""
+    by = {_key(r['tau_s'], r['theta0_deg']): r['class'] for r in rows}
+    return [[by[_key(t, th)] for t in taus] for th in thetas_deg]
+
+
+def boundaries(rows, taus, thetas_deg) -> list[dict]:
+    """Per theta0: the largest tau still settled, and the smallest tau that falls."""
+    g = grid(rows, taus, thetas_deg)
+    out = []
+    for th, row in zip(thetas_deg, g):
+        settled = [t for t, c in zip(taus, row) if c == 'settled']
+        fallen = [t for t, c in zip(taus, row) if c == 'fallen']
+        out.append({'theta0_deg': float(th), 'last_settled_tau_s': max(settled) if settled else None,
+                    'first_fallen_tau_s': min(fallen) if fallen else None})
+    return out
+
+
+def parse_range(text: str) -> np.ndarray:
+    """'start:stop:step' (stop included) or 'a,b,c' -> array."""
+    try:
+        if ':' in text:
+            a, b, s = (float(v) for v in text.split(':'))
+            if s <= 0 or b < a:
+                raise ValueError
+            n = int(math.floor((b - a) / s + 1e-9)) + 1
+            return np.round(a + s * np.arange(n), 9)
+        return np.array([float(v) for v in text.split(',')])
+    except ValueError as exc:
+        raise ValueError(f'range {text!r}: expected start:stop:step with step > 0 and stop >= start, '
+                         f'or a comma-separated list of numbers') from exc
+
+
+def print_progress(done: int, total: int) -> None:
+    sys.stderr.write(f'\r[sweep] {done}/{total} cells')
+    if done == total:
+        sys.stderr.write('\n')
+    sys.stderr.flush()

@@ -1,0 +1,47 @@
+"""Delay / initial-angle sweeps: classes, resume without redoing cells, determinism."""
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ipfric_core.scenario import load_scenario
+from ipfric_core.sweep import boundaries, grid, load_cells, parse_range, sweep
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope='module')
+def fig9_exact():
+    s = load_scenario(ROOT / 'config' / 'fig9_new_gain_exponential.yaml')
+    return replace(s, sim=replace(s.sim, cart_resolution=0.0, angle_resolution=0.0))
+
+
+def test_small_map_has_the_three_regions(fig9_exact, tmp_path):
+    taus, ths = parse_range('0:0.04:0.02'), np.array([1.0])
+    rows = sweep(fig9_exact, taus, ths, 20.0, tmp_path, workers=2)
+    assert grid(rows, taus, ths) == [['settled', 'limit_cycle', 'fallen']]
+    b = boundaries(rows, taus, ths)[0]
+    assert b['last_settled_tau_s'] == 0.0 and b['first_fallen_tau_s'] == 0.04
+
+
+def test_resume_skips_finished_cells_and_is_deterministic(fig9_exact, tmp_path):
+    taus, ths = np.array([0.0, 0.02]), np.array([1.0])
+    first = sweep(fig9_exact, taus, ths, 5.0, tmp_path, workers=1)
+    text = (tmp_path / 'cells.csv').read_text()
+    # simulate an interruption: keep the first cell and half a line
+    lines = text.splitlines()
+    (tmp_path / 'cells.csv').write_text('\n'.join(lines[:2]) + '\n' + lines[2][:10])
+    assert len(load_cells(tmp_path / 'cells.csv')) == 1
+    calls = []
+    again = sweep(fig9_exact, taus, ths, 5.0, tmp_path, workers=1, progress=lambda d, t: calls.append(d))
+    assert calls[0] == 1                      # one cell was already done
+    assert [r['class'] for r in again] == [r['class'] for r in first]
+    assert (tmp_path / 'cells.csv').read_text() == text
+
+
+def test_range_parsing():
+    np.testing.assert_allclose(parse_range('0:0.14:0.005')[[0, -1]], [0.0, 0.14])
+    assert len(parse_range('0:12:0.5')) == 25
+    with pytest.raises(ValueError, match='start:stop:step'):
+        parse_range('0:1:-1')
