@@ -137,3 +137,36 @@ def print_progress(done: int, total: int) -> None:
     if done == total:
         sys.stderr.write('\n')
     sys.stderr.flush()
+
+
+def threshold_angle(base: Scenario, lo: float, hi: float, duration: float, rtol: float = 0.01,
+                    window: float = 20.0, progress: Callable[[float, float], None] | None = None) -> dict:
+    """Bisect the initial angle [rad] separating convergence from the periodic orbit.
+
+    Requires the run from ``lo`` to settle and the run from ``hi`` not to (Figure 8(b):
+    bistability of the equilibrium and a limit cycle). Stops when hi - lo < rtol * hi.
+    """
+    def cls(theta0):
+        scn = replace(base, sim=replace(base.sim, theta0=theta0))
+        tr = run_closed_loop(scn.make_rig(), scn.make_controller(), duration)
+        o = classify(tr.t, tr.measured[:, 0], tr.measured[:, 1],
+                     (scn.sim.cart_resolution, scn.sim.angle_resolution), scn.sim.fallen_angle,
+                     ended_fallen=tr.end_reason != 'duration', window=window)
+        return o
+    c_lo, c_hi = cls(lo), cls(hi)
+    if c_lo.cls != 'settled' or c_hi.cls == 'settled':
+        raise ValueError(f'theta0 = {lo:g} rad gives {c_lo.cls} and {hi:g} rad gives {c_hi.cls}: '
+                         f'the bracket must go from settled to not settled')
+    runs = 2
+    while hi - lo > rtol * hi:
+        mid = math.sqrt(lo * hi) if lo > 0 else 0.5 * hi
+        o = cls(mid)
+        runs += 1
+        if o.cls == 'settled':
+            lo = mid
+        else:
+            hi, c_hi = mid, o
+        if progress:
+            progress(lo, hi)
+    return {'settles_below_rad': lo, 'oscillates_from_rad': hi, 'runs': runs,
+            'orbit_x_p2p_m': c_hi.x_p2p, 'orbit_period_s': c_hi.period_crossings}
