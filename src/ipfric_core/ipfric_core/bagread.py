@@ -48,12 +48,13 @@ class RunData:
 
 
 def mcap_file(path: str | Path) -> Path:
-    """The .mcap of a rosbag2 directory, or ``path`` itself."""
+    """The .mcap of a rosbag2 directory or of a run directory (``bag/``), or ``path`` itself."""
     p = Path(path)
     if p.is_dir():
-        files = sorted(p.glob('*.mcap'))
+        files = sorted(p.glob('*.mcap')) or sorted(p.glob('bag/*.mcap'))  # a bag, or a run directory
         if not files:
-            raise ConfigError(f'{p}: no .mcap file in this directory (expected a rosbag2 directory)')
+            raise ConfigError(f'{p}: no .mcap file here or in {p}/bag (expected a rosbag2 directory, '
+                              f'a run directory of ./ipfric run, or a .mcap file)')
         return files[0]
     if not p.exists():
         raise ConfigError(f'{p}: no such bag (give a rosbag2 directory or a .mcap file)')

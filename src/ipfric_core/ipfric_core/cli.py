@@ -3,11 +3,12 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 
 from .params import ConfigError
-from .paperconfig import DEFAULT_CONFIG, DEFAULT_DATA, load_paper_config
+from .paperconfig import DEFAULT_CONFIG, DEFAULT_DATA, REPO_ROOT, load_paper_config
 
 
 def _print_json(obj) -> None:
@@ -93,6 +94,74 @@ def cmd_demo(args) -> int:
     return rc or cmd_stability(args)
 
 
+def cmd_run(args) -> int:
+    from .runner import cmd_run as run
+    return run(args)
+
+
+def cmd_analyze(args) -> int:
+    from .analysis import analyze_run, overlay_runs
+    results = [analyze_run(p, None if args.no_plots else args.plots) for p in args.runs]
+    out = {'runs': results}
+    if len(args.runs) > 1 and not args.no_plots:
+        out['overlay'] = overlay_runs(args.runs, Path(args.plots) / 'overlay.png')
+    if args.json:
+        _print_json(out)
+        return 0
+    for r in results:
+        print(f'{r["path"]}: {r["class"]}' + (' (TRUNCATED: ' + r['truncation_detail'] + ')' if r['truncated'] else ''))
+        if r.get('class') is None:
+            continue
+        print(f'  {r["samples"]} samples, {r["duration_s"]:.2f} s, end: {r["end_reason"]}; '
+              f'transition at {r["transition_time"] if r["transition_time"] is None else round(r["transition_time"], 3)} s')
+        print(f'  p2p: cart {r["x_p2p"] * 100:.3f} cm, angle {math.degrees(r["theta_p2p"]):.4f} deg; '
+              f'cart at rest {100 * r["stick_fraction"]:.0f} % of the window')
+        if r['period_crossings'] or r['period_spectrum']:
+            pc, ps = r['period_crossings'], r['period_spectrum']
+            print(f'  period: {pc and round(pc, 3)} s (zero crossings), {ps and round(ps, 3)} s (spectrum)')
+        if 'figure' in r:
+            print(f'  figure: {r["figure"]}')
+    if 'overlay' in out:
+        print(f'overlay: {out["overlay"]["figure"]}')
+    return 0
+
+
+def cmd_sweep(args) -> int:
+    from dataclasses import replace
+
+    from .plots import stability_map
+    from .scenario import load_scenario
+    from .sweep import boundaries, grid, parse_range, print_progress, sweep
+    base = load_scenario(args.config)
+    if args.sensors == 'exact':
+        base = replace(base, sim=replace(base.sim, cart_resolution=0.0, angle_resolution=0.0))
+    if args.smoothing:
+        base = replace(base, friction=base.friction.replace(smoothing=args.smoothing))
+    try:
+        taus, ths = parse_range(args.tau), parse_range(args.theta0_deg)
+    except ValueError as exc:
+        raise ConfigError(f'--tau/--theta0-deg: {exc}') from exc
+    out = Path(args.out)
+    rows = sweep(base, taus, ths, args.duration, out, args.workers, None if args.json else print_progress)
+    title = f'{Path(args.config).stem}: {base.friction.model}' + (
+        f', tanh({base.friction.delta:g} v)' if base.friction.smoothing == 'tanh' else '')
+    fig = stability_map(taus, ths, grid(rows, taus, ths), title, out / 'map.png')
+    summary = {'config': args.config, 'sensors': args.sensors, 'duration_s': args.duration,
+               'cells': len(rows), 'figure': str(fig), 'csv': str(out / 'cells.csv'),
+               'counts': {c: sum(r['class'] == c for r in rows) for c in ('settled', 'limit_cycle', 'growing', 'fallen')},
+               'boundaries': boundaries(rows, taus, ths)}
+    (out / 'summary.json').write_text(json.dumps(summary, indent=2, default=float))
+    if args.json:
+        _print_json(summary)
+        return 0
+    print(f'{len(rows)} cells: ' + ', '.join(f'{k} {v}' for k, v in summary['counts'].items()))
+    for b in summary['boundaries']:
+        print(f'  theta0 {b["theta0_deg"]:6.3f} deg: settled up to tau = {b["last_settled_tau_s"]}, '
+              f'falls from tau = {b["first_fallen_tau_s"]}')
+    print(f'map: {fig}\ncells: {out / "cells.csv"}')
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog='ipfric', description='Friction and the inverted pendulum: '
                                 'design, simulation, ROS 2 closed loop and analysis.')
@@ -113,6 +182,31 @@ def build_parser() -> argparse.ArgumentParser:
     m = add('demo', cmd_demo, 'the main job on the default configuration: design and stability report')
     m.add_argument('--config', default=str(DEFAULT_CONFIG), help='paper parameter YAML (default %(default)s)')
     m.add_argument('--data', default=str(DEFAULT_DATA), help='shared data directory (default %(default)s)')
+    r = add('run', cmd_run, 'closed-loop run of the ROS 2 nodes (simulator, controller, recorder) in a fresh '
+            'ROS domain on loopback, recorded to a rosbag2 MCAP directory')
+    r.add_argument('--config', default=str(Path(DEFAULT_CONFIG).parent / 'default.yaml'),
+                   help='scenario parameter file (sim_node / controller_node sections; default %(default)s)')
+    r.add_argument('--duration', type=float, default=None,
+                   help='simulated seconds (default: the file\'s sim_node duration; 0 = until Ctrl-C)')
+    r.add_argument('--out', required=True, help='output directory: bag/, scenario.yaml, logs/, summary.json')
+    r.add_argument('--domain', type=int, default=None, help='ROS_DOMAIN_ID (default: a free one in 1..232)')
+    r.add_argument('--timeout', type=float, default=None, help='stop the run after this many wall seconds')
+    a = add('analyze', cmd_analyze, 'classify recorded runs (settled, limit cycle, growing, fallen): amplitude, '
+            'period, sticking, plots; reads rosbag2 directories, run directories or .mcap files without ROS')
+    a.add_argument('runs', nargs='+', help='run directory, rosbag2 directory or .mcap file')
+    a.add_argument('--plots', default='runs/analysis', help='directory for PNG figures (default %(default)s)')
+    a.add_argument('--no-plots', action='store_true', help='numbers only')
+    w = add('sweep', cmd_sweep, 'stability map over the delay tau and the initial angle theta0 (Figures 11-12), '
+            'offline physics core, parallel and resumable')
+    w.add_argument('--config', default=str(REPO_ROOT / 'config' / 'fig9_new_gain_exponential.yaml'), help='base scenario (default %(default)s)')
+    w.add_argument('--tau', default='0:0.14:0.005', help='delays [s], start:stop:step or a,b,c (default %(default)s)')
+    w.add_argument('--theta0-deg', default='0:12:0.5', help='initial angles [deg] (default %(default)s)')
+    w.add_argument('--duration', type=float, default=20.0, help='simulated seconds per cell (default %(default)s)')
+    w.add_argument('--sensors', choices=('exact', 'config'), default='exact',
+                   help='exact states as in the paper\'s simulations, or the scenario\'s encoders (default %(default)s)')
+    w.add_argument('--smoothing', choices=('none', 'tanh'), default=None, help='override the friction smoothing')
+    w.add_argument('--workers', type=int, default=None, help='processes (default: all cores)')
+    w.add_argument('--out', required=True, help='directory for cells.csv, map.png, summary.json')
     return p
 
 

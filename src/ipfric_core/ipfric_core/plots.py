@@ -12,8 +12,12 @@ import numpy as np  # noqa: E402
 CLASS_COLOURS = {'settled': '#2b8cbe', 'limit_cycle': '#fdae61', 'growing': '#f46d43', 'fallen': '#d7191c'}
 
 
-def run_figure(t, x, theta, voltage_t, voltage, title: str, path: str | Path) -> Path:
-    """Cart position, angle and voltage against time (Figures 7-10), and the phase portrait."""
+def run_figure(t, x, theta, voltage_t, voltage, title: str, path: str | Path, phase=None) -> Path:
+    """Cart position, angle and voltage against time (Figures 7-10), and the phase portrait.
+
+    ``phase`` = (theta [rad], theta' [rad/s]) for the portrait, e.g. the ground truth; by
+    default the encoder angle and its centred difference.
+    """
     fig, ax = plt.subplots(2, 2, figsize=(11, 6.5))
     ax[0, 0].plot(t, x, lw=0.8)
     ax[0, 0].set(xlabel='time (s)', ylabel='position (m)', title='cart position')
@@ -21,10 +25,12 @@ def run_figure(t, x, theta, voltage_t, voltage, title: str, path: str | Path) ->
     ax[1, 0].set(xlabel='time (s)', ylabel='angle (deg)', title='pendulum angle')
     ax[0, 1].plot(voltage_t, voltage, lw=0.6, color='C2')
     ax[0, 1].set(xlabel='time (s)', ylabel='voltage (V)', title='command')
-    if len(t) > 2:
-        dt = np.gradient(t)
-        ax[1, 1].plot(np.degrees(theta), np.degrees(np.gradient(theta) / dt), lw=0.5, color='C3')
-    ax[1, 1].set(xlabel='angle (deg)', ylabel='angular rate (deg/s)', title='phase portrait')
+    if phase is not None:
+        ax[1, 1].plot(np.degrees(phase[0]), np.degrees(phase[1]), lw=0.5, color='C3')
+    elif len(t) > 2:
+        ax[1, 1].plot(np.degrees(theta), np.degrees(np.gradient(theta, t)), lw=0.5, color='C3')
+    ax[1, 1].set(xlabel='angle (deg)', ylabel='angular rate (deg/s)',
+                 title='phase portrait' + (' (ground truth)' if phase is not None else ' (encoder)'))
     for a in ax.flat:
         a.grid(alpha=0.3)
     fig.suptitle(title)

@@ -1,0 +1,369 @@
+"""sim_node: the simulated friction cart-pendulum rig.
+
+Publishes, at every sample k (t_k = k / sample_rate_hz, simulated time):
+
+- ``/clock`` (rosgraph_msgs/Clock) = t_k,
+- ``joint_states`` (sensor_msgs/JointState): encoder positions of ``cart`` [m] and
+  ``pendulum`` [rad] quantized to the encoder resolution, no velocity, no effort,
+- ``plant_state`` (ipfric_msgs/PlantState): the ground truth,
+
+and applies the ``voltage_command`` (ipfric_msgs/VoltageCommand) computed for sample k
+over [t_k, t_k+1) (zero-order hold). ``time_mode``:
+
+- ``lockstep``: sample k+1 is computed only after the command for sample k arrived (or
+  ``lockstep_timeout_s`` of wall time passed): deterministic, faster than real time;
+  the same sequence as :func:`ipfric_core.closedloop.run_closed_loop`.
+- ``realtime``: sample k at wall time t0 + k dt; the latest command is held.
+
+Safety (``safety_event``, ipfric_msgs/SafetyEvent): a NaN, infinite or out-of-range
+command gives 0 V (BAD_COMMAND); no valid command for ``watchdog_samples`` samples gives
+0 V (WATCHDOG); the run ends on TRACK_LIMIT, FALLEN, END (duration reached) or ABORT
+(SIGINT/SIGTERM), announced as an event whose detail lists the messages published.
+All numerics live in ipfric_core (Scenario, Rig); this node adds topics and timing.
+"""
+from __future__ import annotations
+
+import json
+import sys
+import threading
+import time
+from collections import Counter
+
+import rclpy
+from builtin_interfaces.msg import Time
+from ipfric_core.params import ConfigError
+from ipfric_msgs.msg import PlantState, SafetyEvent, VoltageCommand
+from rclpy.duration import Duration
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
+from rclpy.node import Node
+from rclpy.signals import SignalHandlerOptions
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
+
+from ipfric_ros import topics
+from ipfric_ros.parameters import check_unknown, declare, declare_scenario
+from ipfric_ros.signals import StopRequest
+
+from .safety import CommandGuard
+
+
+class StartError(RuntimeError):
+    """The run could not start (peers not found in time)."""
+
+
+class SimNode(Node):
+    """The rig: a Scenario's Rig behind ROS topics."""
+
+    def __init__(self, stop: StopRequest | None = None):
+        super().__init__('sim_node')
+        self.stop = stop if stop is not None else StopRequest()
+        self.scenario = declare_scenario(self, 'sim_node', read_only=True)
+        self.wait_for_recorder = declare(
+            self, 'sim_node', 'wait_for_recorder', False,
+            'before sample 0, wait until a recorder subscribes to every published topic', read_only=True)
+        self.wait_for_gain = declare(
+            self, 'sim_node', 'wait_for_controller_gain', True,
+            'before sample 0, wait for the controller_gain message (the controller is ready)',
+            read_only=True)
+        self.start_timeout = declare(
+            self, 'sim_node', 'start_timeout_s', 60.0,
+            'wall time to wait for the controller (and recorder) before giving up [s]', (0.0, 3600.0),
+            read_only=True)
+        self.result_file = declare(
+            self, 'sim_node', 'result_file', '',
+            'write the end reason and message counts of the run to this JSON file ("" = none)',
+            read_only=True)
+        check_unknown(self, 'sim_node')
+
+        s = self.scenario.sim
+        self.settings = s
+        self.rig = self.scenario.make_rig()
+        self.period_ns = round(1e9 / s.sample_rate_hz)
+        self.last_sample = round(s.duration * s.sample_rate_hz) if s.duration > 0 else None
+        self.guard = CommandGuard(s.voltage_max, s.watchdog_samples)
+        self.lockstep = s.time_mode == 'lockstep'
+
+        qos = topics.data_qos()
+        self.pub_clock = self.create_publisher(Clock, topics.CLOCK, qos)
+        self.pub_joints = self.create_publisher(JointState, topics.JOINT_STATES, qos)
+        self.pub_state = self.create_publisher(PlantState, topics.PLANT_STATE, qos)
+        self.pub_event = self.create_publisher(SafetyEvent, topics.SAFETY_EVENT, topics.data_qos(100))
+        self.sub_command = self.create_subscription(VoltageCommand, topics.VOLTAGE_COMMAND,
+                                                    self._on_command, qos)
+        self.sub_gain = self.create_subscription(Float64MultiArray, topics.CONTROLLER_GAIN,
+                                                 self._on_gain, topics.latched_qos())
+        self.published = Counter()
+        self.gain = None
+        self.stale = 0
+        self._waiting_for = -1      # lockstep: sample whose command is awaited
+        self._command = None        # lockstep: its voltage; realtime: latest unused voltage
+        self._executor = SingleThreadedExecutor()
+        self._executor.add_node(self)
+        # rclpy's own wait set type, as used by rclpy.wait_for_message
+        self._wait_set = _rclpy.WaitSet(1, 0, 0, 0, 0, 0, self.context.handle)
+        self.get_logger().info(
+            f'{s.time_mode} at {s.sample_rate_hz:g} Hz, duration {s.duration:g} s, theta0 {s.theta0:g} rad, '
+            f'friction {self.scenario.friction.model}; encoder {s.cart_resolution:g} m, '
+            f'{s.angle_resolution:g} rad')
+
+    # -- subscriptions ---------------------------------------------------------------------
+    def _on_command(self, msg: VoltageCommand) -> None:
+        if not self.lockstep:
+            self._command = msg.voltage
+        elif msg.sample_index == self._waiting_for:
+            self._command = msg.voltage
+        else:
+            self.stale += 1
+            self.get_logger().warning(f'command for sample {msg.sample_index} ignored while waiting for '
+                                      f'sample {self._waiting_for}', throttle_duration_sec=1.0)
+
+    def _on_gain(self, msg: Float64MultiArray) -> None:
+        self.gain = list(msg.data)
+        self.get_logger().info(f'controller gain {self.gain}')
+
+    # -- publishing ------------------------------------------------------------------------
+    def _stamp(self, k: int) -> Time:
+        return topics.stamp_of_sample(k, self.period_ns)
+
+    def _publish_sample(self) -> None:
+        """Publish /clock, joint_states and plant_state of the current sample."""
+        rig, k = self.rig, self.rig.k
+        stamp = self._stamp(k)
+        x, theta = rig.measure()
+        tr = rig.truth()
+        self.pub_clock.publish(Clock(clock=stamp))
+        js = JointState(name=list(topics.JOINT_NAMES), position=[x, theta])
+        js.header.stamp = stamp
+        self.pub_joints.publish(js)
+        ps = PlantState(x=tr['x'], theta=tr['theta'], x_dot=tr['x_dot'], theta_dot=tr['theta_dot'],
+                        friction_force=tr['friction_force'], z=tr['z'], stuck=bool(tr['stuck']),
+                        voltage_applied=tr['voltage_applied'], sample_index=k)
+        ps.header.stamp = stamp
+        self.pub_state.publish(ps)
+        self.published['/clock'] += 1
+        self.published[topics.JOINT_STATES] += 1
+        self.published[topics.PLANT_STATE] += 1
+
+    def event(self, code: str, detail: str) -> None:
+        k = self.rig.k
+        msg = SafetyEvent(code=code, detail=detail, sample_index=k)
+        msg.header.stamp = self._stamp(k)
+        self.pub_event.publish(msg)
+        self.published[topics.SAFETY_EVENT] += 1
+        text = f'{code} at sample {k} (t = {k * self.period_ns * 1e-9:.3f} s): {detail}'
+        if code in ('START', 'END'):
+            self.get_logger().info(text)
+        else:  # (rclpy wants one severity per call site)
+            self.get_logger().warning(text)
+
+    def _apply(self, command) -> float:
+        v, events = self.guard.apply(command)
+        for code, detail in events:
+            self.event(code, detail)
+        return v
+
+    # -- start -----------------------------------------------------------------------------
+    def _missing_peers(self) -> list[str]:
+        rec = 1 if self.wait_for_recorder else 0
+        need = [(self.pub_joints, topics.JOINT_STATES, 1 + rec), (self.pub_state, topics.PLANT_STATE, rec),
+                (self.pub_clock, topics.CLOCK, rec), (self.pub_event, topics.SAFETY_EVENT, rec)]
+        missing = [f'{name}: {pub.get_subscription_count()}/{n} subscribers'
+                   for pub, name, n in need if pub.get_subscription_count() < n]
+        if self.sub_command.get_publisher_count() < 1:
+            missing.append(f'{topics.VOLTAGE_COMMAND}: no publisher')
+        if self.wait_for_gain and self.gain is None:
+            missing.append(f'{topics.CONTROLLER_GAIN}: not received')
+        return missing
+
+    def wait_for_peers(self) -> bool:
+        """Spin until the controller (and recorder) are matched; False if stopped first."""
+        t0 = time.monotonic()
+        while True:
+            missing = self._missing_peers()
+            if not missing:
+                self.get_logger().info(f'peers matched after {time.monotonic() - t0:.2f} s')
+                return True
+            if self.stop:
+                return False
+            if time.monotonic() - t0 > self.start_timeout:
+                raise StartError(f'peers not matched after {self.start_timeout:g} s: ' + '; '.join(missing))
+            self._executor.spin_once(timeout_sec=0.05)
+
+    # -- loops -----------------------------------------------------------------------------
+    def _end_check(self, limit):
+        if self.stop:
+            return 'ABORT', f'stopped by {self.stop.reason}'
+        if limit:
+            return limit
+        if self.last_sample is not None and self.rig.k >= self.last_sample:
+            return 'END', f'duration {self.settings.duration:g} s reached'
+        return None
+
+    def _take_commands(self, timeout: float) -> None:
+        """Lockstep hot path: wait up to ``timeout`` s on the command subscription alone, take
+        what arrived. Cheaper than an executor turn, which waits on every entity of the node
+        (parameter services included); those are served by an executor turn every 100 samples.
+        """
+        ws, handle = self._wait_set, self.sub_command.handle
+        ws.clear_entities()
+        ws.add_subscription(handle)
+        ws.wait(int(timeout * 1e9))
+        while True:
+            got = handle.take_message(VoltageCommand, False)
+            if got is None:
+                return
+            self._on_command(got[0])
+
+    def _await_command(self, k: int):
+        """Lockstep: wait until the command for sample k arrives; None on timeout."""
+        self._waiting_for, self._command = k, None
+        if k % 100 == 0:
+            self._executor.spin_once(timeout_sec=0.0)
+        self._take_commands(0.0)
+        if self._command is not None or self.guard.tripped:
+            # with the watchdog tripped (0 V held) the rig runs on, taking a command if one is there
+            return self._command
+        t0 = time.monotonic()
+        deadline = t0 + self.settings.lockstep_timeout_s
+        while self._command is None and not self.stop:
+            now = time.monotonic()
+            if now >= deadline:
+                self.get_logger().warning(f'no command for sample {k} within '
+                                          f'{self.settings.lockstep_timeout_s:g} s',
+                                          throttle_duration_sec=1.0)
+                break
+            if now - t0 > 0.02 and self.sub_command.get_publisher_count() == 0:
+                self.get_logger().warning(f'no command publisher (sample {k})', throttle_duration_sec=1.0)
+                break
+            self._take_commands(min(0.02, deadline - now))
+        return self._command
+
+    def run_lockstep(self):
+        while True:
+            self._publish_sample()
+            limit = self.rig.limit_violation()
+            v = self._apply(self._await_command(self.rig.k))
+            end = self._end_check(limit)
+            if end:
+                return end
+            self.rig.step(v)
+
+    def run_realtime(self):
+        """Sample k at wall time t0 + k dt; the latest command that arrived is held (ZOH).
+
+        A command computed from sample k arrives during [t_k, t_k+1) and is applied from
+        t_k+1 on, as on the real rig. Between samples the loop waits on the command
+        subscription until the next deadline; a late sample is taken at once (catching up).
+        """
+        period = self.period_ns * 1e-9
+        t0 = time.monotonic()
+        late = 0
+        while True:
+            command, self._command = self._command, None
+            v = self._apply(command)
+            self._publish_sample()
+            end = self._end_check(self.rig.limit_violation())
+            if end:
+                if late:
+                    self.get_logger().warning(f'{late} samples started more than one period late')
+                return end
+            self.rig.step(v)
+            if self.rig.k % 100 == 0:
+                self._executor.spin_once(timeout_sec=0.0)
+            deadline = t0 + self.rig.k * period
+            now = time.monotonic()
+            if now > deadline + period:
+                late += 1
+            while now < deadline and not self.stop:
+                self._take_commands(deadline - now)
+                now = time.monotonic()
+            self._take_commands(0.0)
+
+    def run(self) -> int:
+        """Wait for peers, run to the end, announce it; the process exit code."""
+        if not self.wait_for_peers():
+            self.get_logger().info(f'stopped by {self.stop.reason} before the start')
+            return 0
+        self.event('START', f'{self.settings.time_mode} run of {self.settings.duration:g} s, '
+                            f'friction {self.scenario.friction.model}, theta0 {self.settings.theta0:g} rad'
+                            + (f', gain {self.gain}' if self.gain else ''))
+        t0 = time.monotonic()
+        code, detail = self.run_lockstep() if self.lockstep else self.run_realtime()
+        wall = time.monotonic() - t0
+        samples = self.rig.k + 1
+        self.published[topics.SAFETY_EVENT] += 1  # the event below
+        counts = dict(sorted(self.published.items()))
+        self.published[topics.SAFETY_EVENT] -= 1
+        self.event(code, f'{detail}; samples {samples}; published {json.dumps(counts)}')
+        self._flush()
+        result = {
+            'end_reason': code, 'detail': detail, 'samples': samples, 'last_sample': self.rig.k,
+            'sim_time_s': self.rig.k * self.period_ns * 1e-9, 'wall_time_s': wall,
+            'steps_per_s': samples / wall if wall > 0 else None, 'published': dict(self.published),
+            'commands_refused': self.guard.refused, 'samples_without_command': self.guard.missing,
+            'stale_commands': self.stale, 'watchdog_tripped': self.guard.tripped,
+            'time_mode': self.settings.time_mode, 'gain': self.gain,
+        }
+        self.get_logger().info(f'run ended: {code} ({detail}); {samples} samples in {wall:.2f} s wall '
+                               f'({result["steps_per_s"]:.0f} samples/s); published {counts}')
+        if self.result_file:
+            with open(self.result_file, 'w') as f:
+                json.dump(result, f, indent=2)
+        return 0
+
+    def _flush(self, timeout: float = 5.0) -> None:
+        """Wait until every subscriber acknowledged what was published (reliable QoS).
+
+        The publishers are waited for in parallel: each wait lasts up to a heartbeat period.
+        """
+        pubs = (self.pub_clock, self.pub_joints, self.pub_state, self.pub_event)
+        acked = {}
+
+        def wait(pub):
+            acked[pub.topic_name] = pub.wait_for_all_acked(Duration(seconds=timeout))
+        threads = [threading.Thread(target=wait, args=(p,)) for p in pubs]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        for name, ok in acked.items():
+            if not ok:
+                self.get_logger().warning(f'{name}: not all messages acknowledged in {timeout:g} s')
+
+
+def main(args=None) -> int:
+    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    stop = StopRequest().install()
+    logger = rclpy.logging.get_logger('sim_node')
+    node = None
+    try:
+        node = SimNode(stop)
+        return node.run()
+    except ConfigError as exc:
+        logger.fatal(f'configuration error: {exc}')
+        return 2
+    except StartError as exc:
+        logger.fatal(str(exc))
+        if node is not None:
+            node.event('ABORT', str(exc))
+            node._flush(1.0)
+        return 1
+    except Exception as exc:  # an internal error still ends the run with a reason
+        logger.fatal(f'internal error: {type(exc).__name__}: {exc}')
+        if node is not None:
+            try:
+                node.event('ABORT', f'internal error: {type(exc).__name__}: {exc}')
+                node._flush(1.0)
+            except Exception:
+                pass
+        raise
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == '__main__':
+    sys.exit(main())

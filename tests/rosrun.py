@@ -1,0 +1,77 @@
+"""Helpers of the ROS tests: scenario files, node processes and an in-process peer.
+
+Every process and the in-process rclpy context get a ROS_DOMAIN_ID of their own (a free
+one, :func:`ipfric_core.runner.pick_domain`) and ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST.
+"""
+from __future__ import annotations
+
+import os
+import subprocess
+import time
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from ipfric_core.runner import executable, pick_domain, ros_environment
+
+ROOT = Path(__file__).resolve().parents[1]
+CONFIG = ROOT / 'config'
+
+
+def scenario_file(tmp_path: Path, name: str, sim: dict | None = None, controller: dict | None = None,
+                  out: str = 'scenario.yaml') -> Path:
+    """config/<name>.yaml with entries of the two sections replaced (dotted keys nest)."""
+    data = yaml.safe_load((CONFIG / name).read_text())
+    for section, changes in (('sim_node', sim), ('controller_node', controller)):
+        params = data[section]['ros__parameters']
+        for key, value in (changes or {}).items():
+            node = params
+            *path, leaf = key.split('.')
+            for p in path:
+                node = node[p]
+            node[leaf] = value
+    path = tmp_path / out
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+def start_node(name: str, args: list, domain: int, log: Path) -> subprocess.Popen:
+    """One ipfric node executable in ``domain`` (loopback only), output to ``log``."""
+    env = ros_environment(domain)
+    env['ROS_LOG_DIR'] = str(log.parent / 'ros')
+    return subprocess.Popen([str(executable(name)), '--ros-args', *args], env=env, cwd=log.parent,
+                            stdout=open(log, 'w'), stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
+
+
+def p2p(t: np.ndarray, x: np.ndarray, last: float = 5.0) -> float:
+    """Peak-to-peak of ``x`` over the last ``last`` seconds of ``t``."""
+    w = t >= t[-1] - last
+    return float(x[w].max() - x[w].min())
+
+
+class Peer:
+    """An rclpy context and node in the test process, in its own domain on loopback."""
+
+    def __init__(self, name: str, domain: int | None = None):
+        import rclpy
+        from rclpy.executors import SingleThreadedExecutor
+        assert os.environ.get('ROS_AUTOMATIC_DISCOVERY_RANGE') == 'LOCALHOST', \
+            'run the tests through ./ipfric test (scripts/env.sh keeps DDS on loopback)'
+        self.domain = domain if domain is not None else pick_domain()
+        self.context = rclpy.Context()
+        rclpy.init(context=self.context, domain_id=self.domain)
+        self.node = rclpy.create_node(name, context=self.context)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+
+    def spin_until(self, condition, timeout: float, what: str) -> None:
+        t0 = time.monotonic()
+        while not condition():
+            assert time.monotonic() - t0 < timeout, f'timed out after {timeout:g} s waiting for {what}'
+            self.executor.spin_once(timeout_sec=0.02)
+
+    def close(self) -> None:
+        self.executor.shutdown()
+        self.node.destroy_node()
+        self.context.try_shutdown()

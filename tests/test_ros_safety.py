@@ -1,0 +1,178 @@
+"""Command safety of the simulator and input checks of the controller.
+
+Unit level: the simulator's command validation and watchdog (ipfric_sim.safety).
+Live: each node against a peer in the test process (its own ROS domain on loopback):
+the simulator receiving NaN, infinite and out-of-range commands; the controller
+receiving a NaN measurement and refusing bad parameter values at run time.
+"""
+import math
+
+import pytest
+
+from ipfric_ros import topics
+from ipfric_sim.safety import BAD_COMMAND, WATCHDOG, CommandGuard, check_command
+from rosrun import Peer, scenario_file, start_node
+
+
+@pytest.mark.parametrize('v, reason', [
+    (math.nan, 'voltage is NaN'), (math.inf, 'voltage is +inf'), (-math.inf, 'voltage is -inf'),
+    (10.5, '|V| = 10.5 V exceeds voltage_max = 10 V'), (-11.0, '|V| = 11 V exceeds voltage_max = 10 V'),
+    ('3', "voltage '3' is not a number"), (None, 'voltage None is not a number'),
+])
+def test_check_command_refuses(v, reason):
+    assert check_command(v, 10.0) == reason
+
+
+@pytest.mark.parametrize('v', [0.0, 10.0, -10.0, 3.25])
+def test_check_command_accepts(v):
+    assert check_command(v, 10.0) is None
+
+
+def test_guard_zero_order_hold_bad_command_and_watchdog():
+    g = CommandGuard(voltage_max=10.0, watchdog_samples=3)
+    assert g.apply(2.0) == (2.0, [])
+    assert g.apply(None) == (2.0, [])                       # held
+    v, ev = g.apply(math.nan)
+    assert v == 0.0 and ev == [(BAD_COMMAND, 'voltage is NaN; 0 V applied')]
+    v, ev = g.apply(None)                                    # third sample without a valid command
+    assert v == 0.0 and [c for c, _ in ev] == [WATCHDOG] and g.tripped
+    assert g.apply(50.0) == (0.0, [])                        # refused silently while tripped
+    assert g.apply(1.5) == (1.5, []) and not g.tripped       # valid commands resume
+    assert g.refused == 2 and g.missing == 2
+
+
+def test_sim_refuses_nan_inf_and_out_of_range_commands(tmp_path):
+    from ipfric_msgs.msg import PlantState, SafetyEvent, VoltageCommand
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float64MultiArray
+    bad = {10: math.nan, 20: math.inf, 30: 25.0}
+    cfg = scenario_file(tmp_path, 'fig7_old_gain_exponential.yaml', sim={'duration': 0.05})
+    peer = Peer('fake_controller')
+    sim = None
+    try:
+        node = peer.node
+        cmd_pub = node.create_publisher(VoltageCommand, topics.VOLTAGE_COMMAND, topics.data_qos())
+        gain_pub = node.create_publisher(Float64MultiArray, topics.CONTROLLER_GAIN, topics.latched_qos())
+        gain_pub.publish(Float64MultiArray(data=[0.0, 0.0, 0.0, 0.0]))
+        events, applied = [], {}
+
+        def on_joints(msg):
+            k = round(topics.stamp_to_ns(msg.header.stamp) / 1e6)
+            cmd = VoltageCommand(voltage=bad.get(k, 1.0), measurement_stamp=msg.header.stamp, sample_index=k)
+            cmd_pub.publish(cmd)
+        node.create_subscription(JointState, topics.JOINT_STATES, on_joints, topics.data_qos())
+        node.create_subscription(SafetyEvent, topics.SAFETY_EVENT, events.append, topics.data_qos(100))
+        node.create_subscription(PlantState, topics.PLANT_STATE,
+                                 lambda m: applied.__setitem__(m.sample_index, m.voltage_applied),
+                                 topics.data_qos())
+        sim = start_node('sim_node', ['--params-file', str(cfg), '-p', 'start_timeout_s:=20.0',
+                                      '-p', f'result_file:={tmp_path / "result.json"}'],
+                         peer.domain, tmp_path / 'sim.log')
+        peer.spin_until(lambda: any(e.code == 'END' for e in events), 60, 'the END event')
+        assert sim.wait(timeout=30) == 0
+        peer.spin_until(lambda: len(applied) == 51, 10, 'every plant_state')
+    finally:
+        peer.close()
+        if sim is not None and sim.poll() is None:
+            sim.kill()
+            sim.wait()
+    codes = [(e.sample_index, e.code) for e in events]
+    assert codes == [(0, 'START'), (10, BAD_COMMAND), (20, BAD_COMMAND), (30, BAD_COMMAND), (50, 'END')]
+    details = [e.detail for e in events if e.code == BAD_COMMAND]
+    assert 'NaN' in details[0] and 'inf' in details[1] and 'exceeds voltage_max' in details[2]
+    # V_k acts over [t_k, t_k+1): plant_state k+1 shows it
+    for k in range(1, 51):
+        assert applied[k] == (0.0 if k - 1 in bad else 1.0), k
+    log = (tmp_path / 'sim.log').read_text()
+    assert 'BAD_COMMAND at sample 10' in log and 'voltage is NaN' in log
+
+
+def test_controller_skips_nan_measurements_and_validates_parameters(tmp_path):
+    from builtin_interfaces.msg import Time
+    from ipfric_msgs.msg import VoltageCommand
+    from rcl_interfaces.srv import SetParameters
+    from rclpy.parameter import Parameter
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float64MultiArray
+    cfg = scenario_file(tmp_path, 'fig9_new_gain_exponential.yaml')
+    peer = Peer('fake_sim')
+    ctl = None
+    try:
+        node = peer.node
+        js_pub = node.create_publisher(JointState, topics.JOINT_STATES, topics.data_qos())
+        cmds, gains = {}, []
+        node.create_subscription(VoltageCommand, topics.VOLTAGE_COMMAND,
+                                 lambda m: cmds.__setitem__(m.sample_index, m), topics.data_qos())
+        node.create_subscription(Float64MultiArray, topics.CONTROLLER_GAIN,
+                                 lambda m: gains.append(list(m.data)), topics.latched_qos())
+        ctl = start_node('controller_node', ['--params-file', str(cfg), '-p', 'use_sim_time:=true'],
+                         peer.domain, tmp_path / 'controller.log')
+        peer.spin_until(lambda: gains and js_pub.get_subscription_count() >= 1, 60, 'the controller')
+        assert gains[0] == [70.7107, 304.9273, 143.3152, 61.0833]
+
+        def send(k, theta):
+            msg = JointState(name=['cart', 'pendulum'], position=[0.0, theta])
+            msg.header.stamp = Time(sec=0, nanosec=k * 1_000_000)
+            js_pub.publish(msg)
+        for k in range(10):
+            send(k, math.nan if k == 5 else 0.01)
+        peer.spin_until(lambda: 9 in cmds, 30, 'the command for sample 9')
+        assert sorted(cmds) == [0, 1, 2, 3, 4, 6, 7, 8, 9]        # nothing for the NaN sample
+        assert cmds[9].measurement_stamp.nanosec == 9_000_000
+        assert cmds[0].voltage == pytest.approx(304.9273 * 0.01)  # K . (0, 0.01, 0, 0)
+
+        client = node.create_client(SetParameters, '/controller_node/set_parameters')
+        peer.spin_until(client.service_is_ready, 30, 'the parameter service')
+
+        def set_param(name, value):
+            req = SetParameters.Request(parameters=[Parameter(name, value=value).to_parameter_msg()])
+            fut = client.call_async(req)
+            peer.spin_until(fut.done, 30, f'set {name}')
+            return fut.result().results[0]
+        r = set_param('delay', 0.0015)
+        assert not r.successful and 'not a multiple of the sample period' in r.reason
+        r = set_param('gain', [1.0, 2.0, 3.0])
+        assert not r.successful and 'expected 4 finite numbers' in r.reason
+        r = set_param('gain', [1.0, 2.0, math.nan, 4.0])
+        assert not r.successful
+        r = set_param('sample_rate_hz', 500.0)
+        assert not r.successful                                    # read-only
+        assert set_param('delay', 0.002).successful
+        assert set_param('gain', [1.0, 2.0, 3.0, 4.0]).successful
+        peer.spin_until(lambda: gains[-1] == [1.0, 2.0, 3.0, 4.0], 30, 'the new gain on controller_gain')
+    finally:
+        peer.close()
+        if ctl is not None:
+            ctl.send_signal(2)
+            assert ctl.wait(timeout=30) == 0
+    log = (tmp_path / 'controller.log').read_text()
+    assert 'sample 5: position not finite' in log
+    assert 'delay set to 0.002' in log and 'rejected 1 measurements' in log
+
+
+def test_controller_designs_the_gain_at_start_up(tmp_path):
+    """gain_source: design: LQR on the exponential model at start-up gives gain (23), published latched."""
+    from std_msgs.msg import Float64MultiArray
+    cfg = scenario_file(tmp_path, 'fig9_new_gain_exponential.yaml', controller={'gain_source': 'design'})
+    text = cfg.read_text().replace('gain_source: design', '''gain_source: design
+    design_friction: {model: exponential, mu_s: 0.0861, mu_c: 0.04287, eps: 3.0, v_s: 0.105, gamma: 2.0,
+                      smoothing: none, delta: 100.0}''')
+    cfg.write_text(text)
+    peer = Peer('gain_listener')
+    ctl = None
+    try:
+        gains = []
+        peer.node.create_subscription(Float64MultiArray, topics.CONTROLLER_GAIN,
+                                      lambda m: gains.append(list(m.data)), topics.latched_qos())
+        # the controller announces itself once a command subscription exists
+        from ipfric_msgs.msg import VoltageCommand
+        peer.node.create_subscription(VoltageCommand, topics.VOLTAGE_COMMAND, lambda m: None, topics.data_qos())
+        ctl = start_node('controller_node', ['--params-file', str(cfg)], peer.domain, tmp_path / 'ctl.log')
+        peer.spin_until(lambda: gains, 60, 'controller_gain')
+    finally:
+        peer.close()
+        if ctl is not None:
+            ctl.send_signal(2)
+            assert ctl.wait(timeout=30) == 0
+    assert gains[0] == pytest.approx([70.7107, 304.9273, 143.3152, 61.0833], rel=1e-4)
+    assert 'designed by LQR on the exponential friction model' in (tmp_path / 'ctl.log').read_text()
