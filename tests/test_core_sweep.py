@@ -45,3 +45,16 @@ def test_range_parsing():
     assert len(parse_range('0:12:0.5')) == 25
     with pytest.raises(ValueError, match='start:stop:step'):
         parse_range('0:1:-1')
+
+
+@pytest.mark.parametrize('name', ['fig9_new_gain_exponential.yaml', 'delay_exponential_tau20ms.yaml'])
+def test_scenario_writes_back_as_the_same_params_file(name, tmp_path):
+    """A sweep cell's ROS parameter file loads back to the very scenario it was made from."""
+    import yaml
+    from ipfric_core.sweep import cell_scenario
+    scn = cell_scenario(load_scenario(ROOT / 'config' / name), np.float64(0.015), np.float64(2.5))
+    path = tmp_path / 'cell.yaml'
+    path.write_text(yaml.safe_dump(scn.to_ros_params()))
+    back = load_scenario(path)
+    assert back == scn
+    assert back.controller.delay == 0.015 and back.sim.theta0 == pytest.approx(np.radians(2.5))

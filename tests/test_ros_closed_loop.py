@@ -4,6 +4,7 @@ Each scenario runs once (simulator, controller and recorder as separate processe
 fresh ROS domain); the tests read the recorded bag back to decide.
 """
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -96,7 +97,6 @@ def test_recorded_counts_equal_published_counts(runs):
 def test_bag_is_rosbag2_mcap_with_configuration(runs):
     res, bag = runs('fig7_old_gain_exponential')
     from mcap.reader import make_reader
-    from pathlib import Path
     from rosbags.highlevel import AnyReader
     from rosbags.typesys import Stores, get_typestore
     meta = yaml.safe_load(Path(res.bag, 'metadata.yaml').read_text())['rosbag2_bagfile_information']
@@ -141,3 +141,51 @@ def test_realtime_mode_is_paced_by_the_wall_clock(tmp_path):
 def test_scenario_files_load(name):
     scn = load_scenario(CONFIG / name)
     assert scn.sim.time_mode == 'lockstep' and len(scn.gain()) == 4
+
+
+def test_analyze_finds_the_figure_7_cycle_in_the_bag(runs, tmp_path):
+    """`./ipfric analyze` on the recorded run: class, amplitude, two agreeing periods, sticking, plots."""
+    from ipfric_core.analysis import analyze_run
+    res, _ = runs('fig7_old_gain_exponential')
+    a = analyze_run(res.out, tmp_path)
+    assert a['class'] == 'limit_cycle' and not a['truncated'] and a['end_reason'] == 'END'
+    assert 8e-3 < a['x_p2p'] < 3e-2                       # of order a centimetre (Figure 7)
+    assert 1.5 < a['period_crossings'] < 5.0 and a['periods_agree']
+    assert abs(a['period_crossings'] - a['period_spectrum']) < 0.1 * a['period_crossings']
+    assert a['stick_fraction'] > 0.2                      # the cart sticks during the cycle
+    assert Path(a['figure']).parent == tmp_path and Path(a['figure']).stat().st_size > 10_000
+
+
+def test_truncated_bag_is_read_up_to_its_last_complete_record(runs, tmp_path):
+    """A recorder killed mid-write: the reader keeps every complete record and says so."""
+    from ipfric_core.analysis import analyze_run
+    res, full = runs('fig7_old_gain_exponential')
+    data = next(Path(res.bag).glob('*.mcap')).read_bytes()
+    cut = tmp_path / 'cut.mcap'
+    cut.write_bytes(data[:int(0.6 * len(data)) + 7])      # ends inside a record
+    bag = read_run(cut)
+    assert bag.truncated and bag.truncation_detail
+    n = len(bag.t)
+    assert 0.3 * len(full.t) < n < 0.75 * len(full.t)
+    assert np.array_equal(bag.x, full.x[:n]) and np.array_equal(bag.theta, full.theta[:n])
+    assert bag.end_reason is None                          # the END event was never written
+    a = analyze_run(cut)
+    assert a['truncated'] and a['class'] == 'limit_cycle'
+
+
+def test_ros_sweep_gives_the_offline_classes(tmp_path):
+    """`./ipfric sweep --ros`: cells through the ROS loop classify exactly as the offline core."""
+    from dataclasses import replace
+
+    from ipfric_core.analysis import analyze_run
+    from ipfric_core.sweep import sweep
+    s = load_scenario(CONFIG / 'fig9_new_gain_exponential.yaml')
+    s = replace(s, sim=replace(s.sim, cart_resolution=0.0, angle_resolution=0.0))
+    taus, ths = [0.0, 0.06], [3.0]
+    ros = sweep(s, taus, ths, 12.0, tmp_path / 'ros', ros=True)
+    off = sweep(s, taus, ths, 12.0, tmp_path / 'off', workers=1)
+    assert [r['class'] for r in ros] == [r['class'] for r in off] == ['settled', 'fallen']
+    for a, b in zip(ros, off):
+        assert a['x_p2p_m'] == pytest.approx(b['x_p2p_m'], abs=1e-12)
+    bags = sorted((tmp_path / 'ros' / 'ros').glob('*/run'))
+    assert [analyze_run(b)['class'] for b in bags] == ['settled', 'fallen']

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +15,14 @@ from .plots import overlay_figure, run_figure
 def _resolution(run: RunData) -> tuple[float, float]:
     sim = (run.config or {}).get('sim', {})
     return sim.get('cart_resolution', 4.54e-5), sim.get('angle_resolution', math.radians(0.08789))
+
+
+def run_name(path: str | Path) -> str:
+    """A figure name for a run: the first path part that is not a generic ``run``, ``bag``, ``bag_0.mcap``."""
+    p = Path(path).resolve()
+    while p.parent != p and re.fullmatch(r'(run|bag)(_\d+)?', p.name.removesuffix('.mcap')):
+        p = p.parent
+    return p.name.removesuffix('.mcap') or 'run'
 
 
 def analyze_run(path: str | Path, plot_dir: str | Path | None = None, window: float = 10.0) -> dict:
@@ -34,7 +43,7 @@ def analyze_run(path: str | Path, plot_dir: str | Path | None = None, window: fl
     if plot_dir is not None:
         d = Path(plot_dir)
         d.mkdir(parents=True, exist_ok=True)
-        name = Path(path).name.removesuffix('.mcap')
+        name = run_name(path)
         title = f'{name}: {o.cls.replace("_", " ")}'
         if o.period_crossings:
             title += f', x p2p {o.x_p2p * 100:.2f} cm, period {o.period_crossings:.2f} s'

@@ -8,6 +8,7 @@ up to its last complete record and reported as truncated.
 from __future__ import annotations
 
 import json
+import struct
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -108,7 +109,7 @@ def read_run(path: str | Path) -> RunData:
                         events.append((_stamp(m.header.stamp), m.code, m.detail))
                     else:
                         gain = list(m.data)
-        except (McapError, EOFError, ValueError, KeyError, AssertionError) as exc:
+        except (McapError, EOFError, ValueError, KeyError, AssertionError, struct.error) as exc:
             truncated, detail = True, f'{type(exc).__name__}: {exc}'
     if not js and not truncated:
         raise ConfigError(f'{f}: no joint_states messages; is this an ipfric run?')

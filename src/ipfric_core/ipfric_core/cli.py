@@ -112,13 +112,16 @@ def cmd_analyze(args) -> int:
         print(f'{r["path"]}: {r["class"]}' + (' (TRUNCATED: ' + r['truncation_detail'] + ')' if r['truncated'] else ''))
         if r.get('class') is None:
             continue
+        tt = r['transition_time']
         print(f'  {r["samples"]} samples, {r["duration_s"]:.2f} s, end: {r["end_reason"]}; '
-              f'transition at {r["transition_time"] if r["transition_time"] is None else round(r["transition_time"], 3)} s')
+              + ('still converging' if tt is None else f'final regime from t = {tt:.3f} s'))
         print(f'  p2p: cart {r["x_p2p"] * 100:.3f} cm, angle {math.degrees(r["theta_p2p"]):.4f} deg; '
               f'cart at rest {100 * r["stick_fraction"]:.0f} % of the window')
         if r['period_crossings'] or r['period_spectrum']:
             pc, ps = r['period_crossings'], r['period_spectrum']
-            print(f'  period: {pc and round(pc, 3)} s (zero crossings), {ps and round(ps, 3)} s (spectrum)')
+            print(f'  period: {pc and round(pc, 3)} s (zero crossings), {ps and round(ps, 3)} s (spectrum)'
+                  + ('' if r['periods_agree'] else ': estimates disagree, an irregular oscillation')
+                  + (f'; {r["frequency"]:.3f} Hz' if r['frequency'] else ''))
         if 'figure' in r:
             print(f'  figure: {r["figure"]}')
     if 'overlay' in out:
@@ -142,11 +145,13 @@ def cmd_sweep(args) -> int:
     except ValueError as exc:
         raise ConfigError(f'--tau/--theta0-deg: {exc}') from exc
     out = Path(args.out)
-    rows = sweep(base, taus, ths, args.duration, out, args.workers, None if args.json else print_progress)
+    rows = sweep(base, taus, ths, args.duration, out, args.workers, None if args.json else print_progress,
+                 ros=args.ros)
     title = f'{Path(args.config).stem}: {base.friction.model}' + (
         f', tanh({base.friction.delta:g} v)' if base.friction.smoothing == 'tanh' else '')
     fig = stability_map(taus, ths, grid(rows, taus, ths), title, out / 'map.png')
     summary = {'config': args.config, 'sensors': args.sensors, 'duration_s': args.duration,
+               'path': 'ros lockstep' if args.ros else 'offline',
                'cells': len(rows), 'figure': str(fig), 'csv': str(out / 'cells.csv'),
                'counts': {c: sum(r['class'] == c for r in rows) for c in ('settled', 'limit_cycle', 'growing', 'fallen')},
                'boundaries': boundaries(rows, taus, ths)}
@@ -205,7 +210,10 @@ def build_parser() -> argparse.ArgumentParser:
     w.add_argument('--sensors', choices=('exact', 'config'), default='exact',
                    help='exact states as in the paper\'s simulations, or the scenario\'s encoders (default %(default)s)')
     w.add_argument('--smoothing', choices=('none', 'tanh'), default=None, help='override the friction smoothing')
-    w.add_argument('--workers', type=int, default=None, help='processes (default: all cores)')
+    w.add_argument('--workers', type=int, default=None,
+                   help='parallel cells (default: all cores offline, 1 with --ros)')
+    w.add_argument('--ros', action='store_true',
+                   help='run each cell through the ROS 2 nodes in lockstep (bags kept in OUT/ros)')
     w.add_argument('--out', required=True, help='directory for cells.csv, map.png, summary.json')
     return p
 

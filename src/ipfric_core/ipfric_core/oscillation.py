@@ -9,7 +9,6 @@ import math
 from dataclasses import asdict, dataclass
 
 import numpy as np
-from numpy.lib.stride_tricks import sliding_window_view
 
 CLASSES = ('settled', 'limit_cycle', 'growing', 'fallen')
 
@@ -24,6 +23,8 @@ class Oscillation:
     x_p2p, theta_p2p : peak-to-peak over the analysis window [m], [rad]
     period_crossings, period_spectrum : s, two independent estimates (None if no cycle)
     frequency : Hz, from the zero-crossing period
+    periods_agree : the two period estimates are within 10 % (a regular cycle; an
+        irregular one, e.g. encoder-count chatter, gives False)
     stick_fraction : share of the window with the cart at rest (encoder plateaus)
     """
 
@@ -36,6 +37,7 @@ class Oscillation:
     frequency: float | None
     stick_fraction: float
     window: tuple
+    periods_agree: bool | None = None
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -101,7 +103,8 @@ def classify(t, x, theta, resolution=(4.54e-5, 1.534e-3), fallen_angle: float = 
         last = np.nonzero(outside)[0]
         tt = float(t[last[-1] + 1]) if len(last) and last[-1] + 1 < len(t) else float(t[0])
         return Oscillation('settled', tt, xp, thp, None, None, None, stick, (float(ts[0]), float(ts[-1])))
-    signal = ths if thp / band_th >= xp / band_x else xs
+    use_theta = thp / band_th >= xp / band_x
+    signal = ths if use_theta else xs
     half = len(signal) // 2
     first, second = float(np.ptp(signal[:half])), float(np.ptp(signal[half:]))
     pc, ps = crossing_period(ts, signal), spectral_period(ts, signal)
@@ -113,16 +116,17 @@ def classify(t, x, theta, resolution=(4.54e-5, 1.534e-3), fallen_angle: float = 
         return Oscillation('settled', None, xp, thp, None, None, None, stick, window_span)
     else:
         cls = 'limit_cycle'
-    onset = _onset(t, x, 0.5 * xp, 1.5 * (pc or ps or 1.0))
-    return Oscillation(cls, onset, xp, thp, pc, ps, 1.0 / pc if pc else None, stick, window_span)
+    onset = _onset(t, theta if use_theta else x, signal)
+    agree = bool(pc and ps and abs(pc - ps) <= 0.1 * max(pc, ps))
+    return Oscillation(cls, onset, xp, thp, pc, ps, 1.0 / pc if pc else None, stick, window_span, agree)
 
 
-def _onset(t, x, half_p2p, span) -> float:
-    """First time after which the cart's envelope over ``span`` [s] stays above half the final p2p."""
-    dt = float(np.median(np.diff(t)))
-    n = max(1, int(round(span / dt)))
-    if len(x) <= n:
-        return float(t[0])
-    env = np.ptp(sliding_window_view(x, n), axis=1)
-    low = np.nonzero(env < half_p2p)[0]
-    return float(t[low[-1] + n]) if len(low) and low[-1] + n < len(t) else float(t[0])
+def _onset(t, y, final) -> float:
+    """Time after which ``y`` stays within the range of the ``final`` regime (+20 % margin).
+
+    Growth from rest and decay from a large start both end there.
+    """
+    lo, hi = float(final.min()), float(final.max())
+    margin = 0.2 * (hi - lo)
+    out = np.nonzero((y < lo - margin) | (y > hi + margin))[0]
+    return float(t[out[-1] + 1]) if len(out) and out[-1] + 1 < len(t) else float(t[0])

@@ -224,6 +224,20 @@ class Scenario:
         return {'sim': asdict(self.sim), 'plant': asdict(self.plant), 'friction': self.friction.to_dict(),
                 'plant_truth': self.truth.to_dict(), 'controller': ctrl, 'gain': self.gain()}
 
+    def to_ros_params(self) -> dict:
+        """The scenario as a ``--params-file`` mapping (inverse of :func:`load_scenario`)."""
+        c = self.controller
+        sim = {**asdict(self.sim), 'plant': asdict(self.plant), 'friction': self.friction.to_dict(),
+               'plant_truth': self.truth.to_dict()}
+        ctrl = {'sample_rate_hz': c.sample_rate_hz, 'gain_source': c.gain_source, 'delay': c.delay,
+                'cutoff_hz': c.cutoff_hz, 'voltage_limit': c.voltage_limit, 'plant': asdict(c.plant),
+                'Q': list(c.Q), 'R': c.R}
+        if c.gain is not None:
+            ctrl['gain'] = list(c.gain)
+        if c.design_friction is not None:
+            ctrl['design_friction'] = c.design_friction.to_dict()
+        return {'sim_node': {'ros__parameters': sim}, 'controller_node': {'ros__parameters': ctrl}}
+
     @staticmethod
     def flat_defaults(node: str) -> dict:
         """Every ROS parameter of ``node`` as name -> (default, description, (lo, hi) or None)."""

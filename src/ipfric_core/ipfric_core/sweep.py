@@ -27,19 +27,50 @@ FIELDS = ('tau_s', 'theta0_deg', 'class', 'transition_time_s', 'x_p2p_m', 'theta
 
 def cell_scenario(base: Scenario, tau: float, theta0_deg: float) -> Scenario:
     """``base`` with the feedback delay tau [s] and initial angle theta0 [deg]."""
-    return replace(base, sim=replace(base.sim, theta0=math.radians(theta0_deg)),
-                   controller=replace(base.controller, delay=tau))
+    return replace(base, sim=replace(base.sim, theta0=math.radians(float(theta0_deg))),
+                   controller=replace(base.controller, delay=float(tau)))
 
 
-def run_cell(base: Scenario, tau: float, theta0_deg: float, duration: float) -> dict:
-    """Run and classify one cell; returns a CSV row."""
+def run_cell(base: Scenario, tau: float, theta0_deg: float, duration: float,
+             ros_dir: str | Path | None = None) -> dict:
+    """Run and classify one cell; returns a CSV row.
+
+    With ``ros_dir`` the cell runs through the ROS 2 loop in lockstep (``./ipfric run``
+    into ``ros_dir/<cell>``) and is classified from its bag; otherwise the offline core runs it.
+    """
     scn = cell_scenario(base, tau, theta0_deg)
-    tr = run_closed_loop(scn.make_rig(), scn.make_controller(), duration)
-    o = classify(tr.t, tr.measured[:, 0], tr.measured[:, 1], (scn.sim.cart_resolution, scn.sim.angle_resolution),
-                 scn.sim.fallen_angle, ended_fallen=tr.end_reason != 'duration')
+    if ros_dir is None:
+        tr = run_closed_loop(scn.make_rig(), scn.make_controller(), duration)
+        t, x, theta, fell = tr.t, tr.measured[:, 0], tr.measured[:, 1], tr.end_reason != 'duration'
+    else:
+        t, x, theta, fell = _ros_cell(scn, Path(ros_dir) / f'tau{tau:.4f}_theta{theta0_deg:.4f}', duration)
+    o = classify(t, x, theta, (scn.sim.cart_resolution, scn.sim.angle_resolution),
+                 scn.sim.fallen_angle, ended_fallen=fell)
     return {'tau_s': round(tau, 9), 'theta0_deg': round(theta0_deg, 9), 'class': o.cls,
             'transition_time_s': o.transition_time, 'x_p2p_m': o.x_p2p, 'theta_p2p_rad': o.theta_p2p,
             'period_s': o.period_crossings}
+
+
+def _ros_cell(scn: Scenario, cell_dir: Path, duration: float):
+    """(t, x, theta, ended by a limit) of one lockstep ROS run of ``scn``."""
+    import shutil
+
+    import yaml
+
+    from .bagread import read_run
+    from .runner import run
+    if cell_dir.exists():          # a cell interrupted before it reached cells.csv: run it again
+        shutil.rmtree(cell_dir)
+    cell_dir.mkdir(parents=True)
+    params = scn.to_ros_params()
+    params['sim_node']['ros__parameters']['time_mode'] = 'lockstep'
+    cfg = cell_dir / 'cell.yaml'
+    cfg.write_text(yaml.safe_dump(params, sort_keys=False))
+    res = run(cfg, cell_dir / 'run', duration=duration, timeout=60.0 + 2.0 * duration)
+    if res.exit_code != 0:
+        raise RuntimeError(f'ROS run of {cell_dir.name} failed:\n{res.summary()}')
+    bag = read_run(res.bag)
+    return bag.t, bag.x, bag.theta, bag.end_reason in ('FALLEN', 'TRACK_LIMIT')
 
 
 def _key(tau, theta0_deg) -> tuple:
@@ -65,8 +96,13 @@ def load_cells(path: Path) -> dict:
 
 
 def sweep(base: Scenario, taus, thetas_deg, duration: float, out_dir: str | Path,
-          workers: int | None = None, progress: Callable[[int, int], None] | None = None) -> list[dict]:
-    """Run every (tau, theta0) cell not already in ``out_dir/cells.csv``; return all rows sorted."""
+          workers: int | None = None, progress: Callable[[int, int], None] | None = None,
+          ros: bool = False) -> list[dict]:
+    """Run every (tau, theta0) cell not already in ``out_dir/cells.csv``; return all rows sorted.
+
+    ``ros``: each cell through the ROS 2 loop in lockstep (bags kept in ``out_dir/ros``;
+    one cell at a time unless ``workers`` says otherwise, each cell being three processes).
+    """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     path = out / 'cells.csv'
@@ -81,8 +117,9 @@ def sweep(base: Scenario, taus, thetas_deg, duration: float, out_dir: str | Path
         finished = total - len(todo)
         if progress:
             progress(finished, total)
-        with ProcessPoolExecutor(max_workers=workers or os.cpu_count()) as pool:
-            futures = [pool.submit(run_cell, base, t, th, duration) for t, th in todo]
+        ros_dir = out / 'ros' if ros else None
+        with ProcessPoolExecutor(max_workers=workers or (1 if ros else os.cpu_count())) as pool:
+            futures = [pool.submit(run_cell, base, t, th, duration, ros_dir) for t, th in todo]
             for fut in as_completed(futures):
                 row = fut.result()
                 w.writerow(row)
