@@ -55,3 +55,31 @@ def test_growing_oscillation_is_recognised():
     t = np.arange(0, 20, 1e-3)
     x = 1e-3 * np.exp(0.2 * t) * np.sin(2 * np.pi * t)
     assert classify(t, x, 0.1 * x).cls == 'growing'
+
+
+def test_slow_cycle_seen_for_two_periods_is_a_cycle():
+    """Exact sensors, sgn friction: the old gain's cycle has a period near 5 s, two in the window."""
+    o = analysed(paper.GAIN_15_VISCOUS, 0.02, exact=True)
+    assert o.cls == 'limit_cycle' and o.periods_agree
+    assert 4.0 < o.period_crossings < 7.0
+    assert 0.008 < o.x_p2p < 0.03
+
+
+def test_creep_and_irregular_chatter():
+    t = np.arange(0, 20, 1e-3)
+    creep = 2e-3 * np.exp(-t / 30) + 2e-4 * np.sin(2 * np.pi * t / 25)   # less than 1.5 periods visible
+    assert classify(t, creep, 0 * t).cls == 'settled'
+    rng = np.random.default_rng(1)
+    chatter = 1e-3 * np.round(np.cumsum(rng.standard_normal(len(t))) / 40 % 3)  # irregular jumps
+    o = classify(t, chatter, 0 * t)
+    assert o.cls == 'limit_cycle' and not o.periods_agree
+
+
+def test_final_regime_time_marks_the_end_of_the_transient():
+    t = np.arange(0, 20, 1e-3)
+    x = 0.02 * np.exp(-t) + 1e-3 * np.sin(2 * np.pi * t)      # decays onto a 2 mm cycle
+    o = classify(t, x, 0 * t)
+    assert o.cls == 'limit_cycle'
+    # the transient's excess over the cycle falls below 20 % of its p2p (0.4 mm) at ln(50) = 3.9 s,
+    # seen at the last peak of the cycle before that
+    assert np.log(50) - 1.0 < o.transition_time < np.log(50)

@@ -129,24 +129,145 @@ def cmd_analyze(args) -> int:
     return 0
 
 
-def cmd_sweep(args) -> int:
+def _sweep_base(config, sensors, smoothing, cutoff_hz=None):
     from dataclasses import replace
 
-    from .plots import stability_map
     from .scenario import load_scenario
-    from .sweep import boundaries, grid, parse_range, print_progress, sweep
-    base = load_scenario(args.config)
-    if args.sensors == 'exact':
+    base = load_scenario(config)
+    if cutoff_hz is not None:
+        if not (math.isfinite(cutoff_hz) and cutoff_hz >= 0):
+            raise ConfigError(f'--cutoff-hz: {cutoff_hz!r} must be >= 0 Hz (0 = raw difference)')
+        base = replace(base, controller=replace(base.controller, cutoff_hz=cutoff_hz))
+    if sensors == 'exact':
         base = replace(base, sim=replace(base.sim, cart_resolution=0.0, angle_resolution=0.0))
-    if args.smoothing:
-        base = replace(base, friction=base.friction.replace(smoothing=args.smoothing))
+    if smoothing:
+        base = replace(base, friction=base.friction.replace(smoothing=smoothing))
+    return base
+
+
+# The paper's Figures 11-12: scenario, variants (label, smoothing, line style), grids (name, theta0 range [deg])
+FIGURES = {
+    '11': ('fig9_new_gain_exponential.yaml', [('sgn', 'none', '--'), ('tanh(100v)', 'tanh', '-')]),
+    '12': ('fig10_new_gain_dynamic.yaml', [('dynamic', None, '-')]),
+}
+# theta0 = 0 is left out: with exact sensors the run stays at the equilibrium for any delay
+FIGURE_GRIDS = (('full', '1:12:1'), ('zoom', '0.05:0.5:0.05'))
+
+
+def _figure_sweep(args, taus, progress) -> dict:
+    from .plots import transition_figure
+    from .sweep import boundaries, grid, parse_range, sweep
+    name, variants = FIGURES[args.figure]
+    config = REPO_ROOT / 'config' / name
+    out = Path(args.out)
+    panels, result = [], {'figure_of_paper': args.figure, 'config': str(config), 'variants': {}}
+    for gname, trange in FIGURE_GRIDS:
+        ths = parse_range(trange)
+        panel = {'title': f'θ0 {ths[0]:g}-{ths[-1]:g} deg', 'taus': taus, 'thetas_deg': ths, 'curves': []}
+        for label, smoothing, style in variants:
+            base = _sweep_base(config, args.sensors, smoothing, args.cutoff_hz)
+            d = out / f'{gname}_{smoothing or "model"}'
+            if progress:
+                print(f'[sweep] {label}, {gname} grid -> {d}', file=sys.stderr)
+            rows = sweep(base, taus, ths, args.duration, d, args.workers, progress, ros=args.ros)
+            b = boundaries(rows, taus, ths)
+            panel.setdefault('classes', grid(rows, taus, ths))
+            panel['curves'].append((label, style, ths, [r['first_unsettled_tau_s'] for r in b],
+                                    [r['first_fallen_tau_s'] for r in b]))
+            result['variants'].setdefault(label, {})[gname] = {'csv': str(d / 'cells.csv'), 'boundaries': b}
+        panels.append(panel)
+    title = f'Figure {args.figure}: {name.removesuffix(".yaml")}, {args.sensors} sensors, {args.duration:g} s runs'
+    result['figure'] = str(transition_figure(panels, title, out / f'figure{args.figure}.png'))
+    return result
+
+
+def _resolution_sweep(args, out: Path) -> int:
+    from .plots import resolution_figure
+    from .sweep import parse_range, resolution_study
+    try:
+        scales = parse_range(args.resolution_scale)
+    except ValueError as exc:
+        raise ConfigError(f'--resolution-scale: {exc}') from exc
+    if (scales < 0).any():
+        raise ConfigError('--resolution-scale: scales must be >= 0 (0 = exact sensors, 1 = the scenario\'s)')
+    base = _sweep_base(args.config, 'config', args.smoothing, args.cutoff_hz)
+    rows = resolution_study(base, scales, args.duration, args.scale_sensor, args.workers)
+    out.mkdir(parents=True, exist_ok=True)
+    fig = resolution_figure(rows, f'{Path(args.config).stem}: oscillation against {args.scale_sensor} '
+                            'encoder resolution',
+                            out / 'resolution.png')
+    summary = {'config': args.config, 'duration_s': args.duration, 'scaled': args.scale_sensor, 'rows': rows,
+               'figure': str(fig)}
+    (out / 'resolution.json').write_text(json.dumps(summary, indent=2, default=float))
+    if args.json:
+        _print_json(summary)
+        return 0
+    print(f'{"scale":>6} {"angle count":>12} {"class":>12} {"cart p2p":>10} {"angle p2p":>10}')
+    for r in rows:
+        print(f'{r["scale"]:6.2f} {math.degrees(r["angle_resolution_rad"]):10.5f}° {r["class"]:>12} '
+              f'{r["true_x_p2p_m"] * 1e3:8.3f}mm {math.degrees(r["true_theta_p2p_rad"]):9.4f}°')
+    print(f'figure: {fig}')
+    return 0
+
+
+def _threshold(args, out: Path) -> int:
+    from .sweep import threshold_angle
+    try:
+        lo, hi = (float(v) for v in args.threshold.split(','))
+    except ValueError as exc:
+        raise ConfigError(f'--threshold: {args.threshold!r}: expected LO,HI in rad, e.g. 1e-5,1e-3') from exc
+    if not 0 <= lo < hi:
+        raise ConfigError(f'--threshold: need 0 <= LO < HI, got {lo:g}, {hi:g}')
+    base = _sweep_base(args.config, args.sensors, args.smoothing, args.cutoff_hz)
+
+    def progress(a, b):
+        print(f'[threshold] settles from {a:.4g} rad, cycles from {b:.4g} rad', file=sys.stderr)
+    try:
+        res = threshold_angle(base, lo, hi, args.duration, progress=None if args.json else progress)
+    except ValueError as exc:
+        raise ConfigError(f'--threshold: {exc}') from exc
+    res.update(config=args.config, sensors=args.sensors, cutoff_hz=base.controller.cutoff_hz,
+               duration_s=args.duration)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / 'threshold.json').write_text(json.dumps(res, indent=2, default=float))
+    if args.json:
+        _print_json(res)
+        return 0
+    print(f'converges for theta0 <= {res["settles_below_rad"]:.4g} rad, leaves the equilibrium from '
+          f'{res["oscillates_from_rad"]:.4g} rad ({res["runs"]} runs of {args.duration:g} s); that run ends '
+          f'{res["hi_class"].replace("_", " ")}, cart p2p {res["hi_x_p2p_m"] * 1e3:.2f} mm over the last 20 s')
+    return 0
+
+
+def cmd_sweep(args) -> int:
+    from .plots import stability_map
+    from .sweep import boundaries, grid, parse_range, print_progress, sweep
     try:
         taus, ths = parse_range(args.tau), parse_range(args.theta0_deg)
     except ValueError as exc:
         raise ConfigError(f'--tau/--theta0-deg: {exc}') from exc
+    progress = None if args.json else print_progress
     out = Path(args.out)
-    rows = sweep(base, taus, ths, args.duration, out, args.workers, None if args.json else print_progress,
-                 ros=args.ros)
+    if args.figure:
+        summary = _figure_sweep(args, taus, progress)
+        (out / 'summary.json').write_text(json.dumps(summary, indent=2, default=float))
+        if args.json:
+            _print_json(summary)
+            return 0
+        for label, grids in summary['variants'].items():
+            for gname, g in grids.items():
+                print(f'{label}, {gname}:')
+                for b in g['boundaries']:
+                    print(f'  theta0 {b["theta0_deg"]:6.3f} deg: settled up to tau = {b["last_settled_tau_s"]}, '
+                          f'falls from tau = {b["first_fallen_tau_s"]}')
+        print(f'figure: {summary["figure"]}')
+        return 0
+    if args.resolution_scale:
+        return _resolution_sweep(args, out)
+    if args.threshold:
+        return _threshold(args, out)
+    base = _sweep_base(args.config, args.sensors, args.smoothing, args.cutoff_hz)
+    rows = sweep(base, taus, ths, args.duration, out, args.workers, progress, ros=args.ros)
     title = f'{Path(args.config).stem}: {base.friction.model}' + (
         f', tanh({base.friction.delta:g} v)' if base.friction.smoothing == 'tanh' else '')
     fig = stability_map(taus, ths, grid(rows, taus, ths), title, out / 'map.png')
@@ -214,6 +335,20 @@ def build_parser() -> argparse.ArgumentParser:
                    help='parallel cells (default: all cores offline, 1 with --ros)')
     w.add_argument('--ros', action='store_true',
                    help='run each cell through the ROS 2 nodes in lockstep (bags kept in OUT/ros)')
+    w.add_argument('--figure', choices=sorted(FIGURES), default=None,
+                   help='the paper\'s Figure 11 (exponential model, sgn and tanh(100 v)) or 12 (dynamic model): '
+                        'full theta0 0-12 deg and zoom 0-0.5 deg grids, transition lines on the map; '
+                        'ignores --config, --theta0-deg and --smoothing')
+    w.add_argument('--resolution-scale', default=None, metavar='SCALES',
+                   help='instead of a map: one run per multiple of the scenario\'s encoder counts '
+                        '(e.g. 0,0.25,0.5,1,2,4; 0 = exact), oscillation amplitude against resolution (section 6)')
+    w.add_argument('--scale-sensor', choices=('angle', 'cart', 'both'), default='angle',
+                   help='which encoder --resolution-scale scales (default %(default)s)')
+    w.add_argument('--threshold', default=None, metavar='LO,HI',
+                   help='instead of a map: bisect the initial angle [rad] between a settling LO and a '
+                        'cycling HI (bistability, Figure 8b)')
+    w.add_argument('--cutoff-hz', type=float, default=None,
+                   help='override the controller\'s velocity filter corner [Hz] (0 = raw difference)')
     w.add_argument('--out', required=True, help='directory for cells.csv, map.png, summary.json')
     return p
 

@@ -44,13 +44,19 @@ class Oscillation:
 
 
 def crossing_period(t: np.ndarray, y: np.ndarray) -> float | None:
-    """Mean period [s] from upward crossings of the mean (linear interpolation)."""
+    """Mean period [s] from crossings of the mean (linear interpolation).
+
+    Upward crossings when there are at least two; otherwise twice the interval between an
+    upward and a downward crossing (a slow cycle seen for barely one period); None with
+    fewer than two crossings.
+    """
     y = y - y.mean()
-    idx = np.nonzero((y[:-1] < 0) & (y[1:] >= 0))[0]
+    up = np.nonzero((y[:-1] < 0) & (y[1:] >= 0))[0]
+    idx = up if len(up) >= 2 else np.nonzero((y[:-1] < 0) != (y[1:] < 0))[0]
     if len(idx) < 2:
         return None
     tc = t[idx] - y[idx] * (t[idx + 1] - t[idx]) / (y[idx + 1] - y[idx])
-    return float(np.mean(np.diff(tc)))
+    return float(np.mean(np.diff(tc))) * (1 if len(up) >= 2 else 2)
 
 
 def spectral_period(t: np.ndarray, y: np.ndarray) -> float | None:
@@ -82,7 +88,7 @@ def classify(t, x, theta, resolution=(4.54e-5, 1.534e-3), fallen_angle: float = 
     their mean.
     The larger of the two signals (in counts) then decides: growing if the second half
     of the window has over 1.25 times the peak-to-peak of the first; settled (still
-    converging) if it has under half, or if the signal does not cross its mean twice
+    converging) if it has under half, or if the window holds under 1.5 periods
     (a creep, not an oscillation); otherwise a limit cycle. Fallen: |theta| reached ``fallen_angle``, or the run ended on a
     safety limit (``ended_fallen``: the pendulum fell or the cart hit the track end).
     """
@@ -111,8 +117,8 @@ def classify(t, x, theta, resolution=(4.54e-5, 1.534e-3), fallen_angle: float = 
     window_span = (float(ts[0]), float(ts[-1]))
     if second > 1.25 * first:
         cls = 'growing'
-    elif second < 0.5 * first or pc is None:
-        # decaying, or a creep without oscillation: converging to rest
+    elif second < 0.5 * first or pc is None or pc > (ts[-1] - ts[0]) / 1.5:
+        # decaying, or a creep without 1.5 visible cycles: converging to rest
         return Oscillation('settled', None, xp, thp, None, None, None, stick, window_span)
     else:
         cls = 'limit_cycle'
