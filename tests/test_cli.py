@@ -37,3 +37,17 @@ def test_bad_config_is_a_clear_error(tmp_path):
     out = cli('design', '--config', str(bad))
     assert out.returncode == 2
     assert "friction.dynamic.model: 'bristle' is not one of viscous, coulomb, exponential, dynamic" in out.stderr
+
+
+def test_demo_runs_the_default_scenario_and_analyses_it(tmp_path):
+    """The README's main job: a closed-loop ROS run of config/default.yaml, then its analysis."""
+    out = tmp_path / 'demo'
+    r = subprocess.run([str(ROOT / 'ipfric'), 'demo', '--json', '--duration', '12', '--out', str(out)],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr[-2000:]
+    res = json.loads(r.stdout)
+    assert res['run']['end_reason'] == 'END' and res['run']['samples'] == 12001
+    a = res['analysis']
+    assert a['class'] == 'limit_cycle' and a['gain'] == [70.7107, 142.5409, 50.6911, 26.9817]
+    assert 8e-3 < a['x_p2p'] < 3e-2
+    assert (out / 'analysis.json').exists() and Path(a['figure']).exists()

@@ -82,21 +82,59 @@ def cmd_stability(args) -> int:
 
 
 def cmd_demo(args) -> int:
-    """The README's main job: the paper's design and stability report."""
+    """The README's main job: a closed-loop ROS 2 run of the default scenario, then its analysis."""
+    import time
+
+    from .analysis import analyze_run
+    from .runner import Run
+    out = Path(args.out) if args.out else REPO_ROOT / 'runs' / time.strftime('demo-%Y%m%d-%H%M%S')
+    r = Run(args.config, out, args.duration, timeout=600.0)
+    if not args.json:
+        print(f'[demo] closed-loop run of {args.config} through the ROS 2 nodes -> {out}', file=sys.stderr)
+    r.start()
+    try:
+        res = r.wait()
+    except KeyboardInterrupt:
+        r.kill()
+        raise
+    if res.exit_code != 0:
+        print(res.summary(), file=sys.stderr)
+        return res.exit_code
+    a = analyze_run(out, out / 'plots')
+    summary = {'run': res.to_dict(), 'analysis': a}
+    (out / 'analysis.json').write_text(json.dumps(summary, indent=2, default=float))
     if args.json:
-        from .reports import design_report, stability_report
-        cfg = load_paper_config(args.config)
-        _print_json({'design': design_report(cfg, Path(args.data) / 'paper'),
-                     'stability': stability_report(cfg)})
+        _print_json(summary)
         return 0
-    rc = cmd_design(args)
+    print(res.summary())
     print()
-    return rc or cmd_stability(args)
+    _print_analysis(a)
+    print(f'analysis: {out / "analysis.json"}')
+    return 0
 
 
 def cmd_run(args) -> int:
     from .runner import cmd_run as run
     return run(args)
+
+
+def _print_analysis(r: dict) -> None:
+    """Readable summary of one :func:`analysis.analyze_run` result."""
+    print(f'{r["path"]}: {r["class"]}' + (' (TRUNCATED: ' + r['truncation_detail'] + ')' if r['truncated'] else ''))
+    if r.get('class') is None:
+        return
+    tt = r['transition_time']
+    print(f'  {r["samples"]} samples, {r["duration_s"]:.2f} s, end: {r["end_reason"]}; '
+          + ('still converging' if tt is None else f'final regime from t = {tt:.3f} s'))
+    print(f'  p2p: cart {r["x_p2p"] * 100:.3f} cm, angle {math.degrees(r["theta_p2p"]):.4f} deg; '
+          f'cart at rest {100 * r["stick_fraction"]:.0f} % of the window')
+    if r['period_crossings'] or r['period_spectrum']:
+        pc, ps = r['period_crossings'], r['period_spectrum']
+        print(f'  period: {pc and round(pc, 3)} s (zero crossings), {ps and round(ps, 3)} s (spectrum)'
+              + ('' if r['periods_agree'] else ': estimates disagree, an irregular oscillation')
+              + (f'; {r["frequency"]:.3f} Hz' if r['frequency'] else ''))
+    if 'figure' in r:
+        print(f'  figure: {r["figure"]}')
 
 
 def cmd_analyze(args) -> int:
@@ -109,21 +147,7 @@ def cmd_analyze(args) -> int:
         _print_json(out)
         return 0
     for r in results:
-        print(f'{r["path"]}: {r["class"]}' + (' (TRUNCATED: ' + r['truncation_detail'] + ')' if r['truncated'] else ''))
-        if r.get('class') is None:
-            continue
-        tt = r['transition_time']
-        print(f'  {r["samples"]} samples, {r["duration_s"]:.2f} s, end: {r["end_reason"]}; '
-              + ('still converging' if tt is None else f'final regime from t = {tt:.3f} s'))
-        print(f'  p2p: cart {r["x_p2p"] * 100:.3f} cm, angle {math.degrees(r["theta_p2p"]):.4f} deg; '
-              f'cart at rest {100 * r["stick_fraction"]:.0f} % of the window')
-        if r['period_crossings'] or r['period_spectrum']:
-            pc, ps = r['period_crossings'], r['period_spectrum']
-            print(f'  period: {pc and round(pc, 3)} s (zero crossings), {ps and round(ps, 3)} s (spectrum)'
-                  + ('' if r['periods_agree'] else ': estimates disagree, an irregular oscillation')
-                  + (f'; {r["frequency"]:.3f} Hz' if r['frequency'] else ''))
-        if 'figure' in r:
-            print(f'  figure: {r["figure"]}')
+        _print_analysis(r)
     if 'overlay' in out:
         print(f'overlay: {out["overlay"]["figure"]}')
     return 0
@@ -305,9 +329,12 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument('--data', default=str(DEFAULT_DATA), help='shared data directory (default %(default)s)')
     s = add('stability', cmd_stability, 'Routh-Hurwitz thresholds in delta and critical delays tau_c')
     s.add_argument('--config', default=str(DEFAULT_CONFIG), help='paper parameter YAML (default %(default)s)')
-    m = add('demo', cmd_demo, 'the main job on the default configuration: design and stability report')
-    m.add_argument('--config', default=str(DEFAULT_CONFIG), help='paper parameter YAML (default %(default)s)')
-    m.add_argument('--data', default=str(DEFAULT_DATA), help='shared data directory (default %(default)s)')
+    m = add('demo', cmd_demo, 'the main job: a closed-loop run of the default scenario through the ROS 2 '
+            'nodes (Figure 7: gain (15) on the stick-slip plant), recorded and analysed')
+    m.add_argument('--config', default=str(REPO_ROOT / 'config' / 'default.yaml'),
+                   help='scenario parameter file (default %(default)s)')
+    m.add_argument('--duration', type=float, default=None, help='simulated seconds (default: the file\'s)')
+    m.add_argument('--out', default=None, help='run directory (default runs/demo-<time>)')
     r = add('run', cmd_run, 'closed-loop run of the ROS 2 nodes (simulator, controller, recorder) in a fresh '
             'ROS domain on loopback, recorded to a rosbag2 MCAP directory')
     r.add_argument('--config', default=str(Path(DEFAULT_CONFIG).parent / 'default.yaml'),
