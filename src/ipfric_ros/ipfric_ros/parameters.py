@@ -87,11 +87,12 @@ def _reason(exc: Exception) -> str:
 
 def check_unknown(node, section: str) -> None:
     """Refuse names in the parameter file that the node does not declare (typos)."""
+    # rclpy keeps the parameter-file entries only in this attribute (no public accessor)
     overrides = getattr(node, '_parameter_overrides', {}) or {}
     unknown = sorted(n for n in overrides if not node.has_parameter(n) and not n.startswith('qos_overrides.'))
     if not unknown:
         return
-    known = sorted(p for p in node._parameters) if hasattr(node, '_parameters') else []
+    known = sorted(node.list_parameters([], 0).names)
     hints = []
     for n in unknown:
         close = difflib.get_close_matches(n, known, n=1)
