@@ -44,11 +44,12 @@ class Effect:
 BASE_PARAMS = (Param('mass', 'kg', 1e-3, 1e4, None), Param('eps', 'N s/m', -1e4, 1e4, 0.0))
 
 EFFECTS = {e.name: e for e in (
-    Effect('coulomb', (Param('Fc', 'N', 0.0, 1e4),), 'friction', 'velocity_sign',
-           'Coulomb friction Fc sgn(x\'), eqs. (4)-(7): the residual jumps across x\' = 0'),
-    Effect('stribeck', (Param('Fs_excess', 'N', 0.0, 1e4), Param('v_s', 'm/s', 1e-4, 10.0, None)), 'friction',
-           'speed', 'static excess (Fs - Fc) exp(-(|x\'|/v_s)^2) sgn(x\'), eq. (8) with gamma = 2: the '
-           'residual falls with speed at low |x\'|', requires=('coulomb',)),
+    Effect('coulomb', (Param('Fc', 'N', 0.0, 1e4), Param('Fs_excess', 'N', 0.0, 1e4)), 'friction',
+           'velocity_sign', 'Coulomb and static friction, eqs. (4)-(7): Fc sgn(x\') while sliding, the '
+           'cart held up to Fs = Fc + Fs_excess (seen at breakaway): the residual jumps across x\' = 0'),
+    Effect('stribeck', (Param('v_s', 'm/s', 1e-4, 10.0, None),), 'friction',
+           'speed', 'the sliding level falls from Fs to Fc as exp(-(|x\'|/v_s)^2), eq. (8) with gamma = 2: '
+           'the residual falls with speed at low |x\'|', requires=('coulomb',)),
     Effect('presliding', (Param('sigma0', 'N/m', 1.0, 1e7, None), Param('sigma1', 'N s/m', 0.0, 1e5)),
            'friction', 'reversal', 'bristle (dynamic) friction, eqs. (10)-(11): sigma0 z replaces the '
            'sliding level; a transient after each reversal', requires=('coulomb',)),
@@ -104,6 +105,14 @@ def input_effects(t: np.ndarray, u: np.ndarray, p: dict, active) -> np.ndarray:
     return u
 
 
+def plateaus(t: np.ndarray, x: np.ndarray, min_duration: float) -> list[tuple[int, int]]:
+    """(first, last) sample of each stretch where the encoder x stays put >= ``min_duration`` [s]."""
+    moves = np.nonzero(np.diff(x) != 0.0)[0]
+    starts = np.concatenate([[0], moves + 1])
+    ends = np.concatenate([moves, [len(x) - 1]])
+    return [(int(a), int(b)) for a, b in zip(starts, ends) if t[b] - t[a] >= min_duration]
+
+
 def dwell_profile(t: np.ndarray, x: np.ndarray) -> np.ndarray:
     """D(t) in [-1, 1] with x_true = x_meas + gap/2 D for a play of width gap.
 
@@ -130,7 +139,7 @@ def dwell_profile(t: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 
 def stribeck_level(speed: np.ndarray, p: dict, active) -> np.ndarray:
-    """Sliding level g(v) [N]: Fc (+ excess exp(-(|v|/v_s)^2)), eq. (8) with gamma = 2."""
+    """Sliding level g(v) [N]: Fc (+ (Fs - Fc) exp(-(|v|/v_s)^2)), eq. (8) with gamma = 2."""
     g = np.full_like(speed, p.get('Fc', 0.0) if 'coulomb' in active else 0.0)
     if 'stribeck' in active:
         g = g + p['Fs_excess'] * np.exp(-(speed / p['v_s']) ** 2)
@@ -150,6 +159,22 @@ def bristle_state(v: np.ndarray, level: np.ndarray, sigma0: float, dt: float) ->
     return z
 
 
+def static_level(p: dict, active) -> float:
+    """Fs [N]: the largest force static friction holds (0 without the coulomb effect), eq. (5)."""
+    return p['Fc'] + p['Fs_excess'] if 'coulomb' in active else 0.0
+
+
+def position_force(x, p: dict, active):
+    """Forces fixed to the track or constant [N] (offset, cogging): they act at rest too."""
+    r = np.zeros_like(np.asarray(x, float))
+    if 'offset' in active:
+        r = r + p['F0']
+    if 'cogging' in active:
+        ph = 2 * np.pi * x / p['cog_period']
+        r = r + p['cog_sin'] * np.sin(ph) + p['cog_cos'] * np.cos(ph)
+    return r
+
+
 def resisting_force(x, v, p: dict, active, dt: float) -> np.ndarray:
     """R [N]: the force the drive must supply against friction and the other forces."""
     speed = np.abs(v)
@@ -164,9 +189,4 @@ def resisting_force(x, v, p: dict, active, dt: float) -> np.ndarray:
             r = r + g * sgn
     if 'asymmetry' in active:
         r = r + p['dFc'] * (speed > 0) + p['dFv'] * speed
-    if 'offset' in active:
-        r = r + p['F0']
-    if 'cogging' in active:
-        ph = 2 * np.pi * x / p['cog_period']
-        r = r + p['cog_sin'] * np.sin(ph) + p['cog_cos'] * np.cos(ph)
-    return r
+    return r + position_force(x, p, active)
