@@ -13,7 +13,7 @@ Search (:func:`identify`): fit the base model; then, round by round, refit with 
 remaining candidate effect, rank the candidates by how much estimation error each
 removes, and keep the best only if it pays on the validation data: the Bayesian
 information criterion on estimation drops, the validation RMS drops by more than
-``min_gain_percent``, and the drop is significant (p < P_VALUE in a signed-rank test
+``min_gain_percent``, and the drop is significant (p < P_VALUE in a block bootstrap
 over quarter-second blocks). Stop when the residual is white or nothing pays.
 """
 from __future__ import annotations
@@ -24,7 +24,6 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 from scipy.signal import butter, sosfiltfilt
-from scipy.stats import wilcoxon
 
 from . import effects as fx
 from .dataio import Record
@@ -33,6 +32,7 @@ from .residual import signature_scores, whiteness
 MIN_GAIN_PERCENT = 3.0
 P_VALUE = 0.01
 BLOCK_S = 0.25
+BOOTSTRAP = 2000
 EDGE_S = 0.15
 TICK_S = 0.02
 STUCK_S = 0.05  # an encoder standing still this long [s] shows a stuck cart
@@ -157,7 +157,7 @@ def balance(pr: Prepared, p: dict, active) -> Balance:
         model = model + m * (1 - 0.75 * c * c) * a - m * l * s * pr.thd ** 2 + 0.75 * m * gr * c * s
         pend = m * ((4.0 / 3.0) * l * pr.thdd - gr * s + a * c)
     model = model + fx.resisting_force(x, v, p, active, pr.dt)
-    used = pr.inside & ~pr.near(np.abs(v) < rec.stick_velocity)
+    used = pr.used
     static = np.zeros(0)
     if len(pr.b_idx):
         # held force: input less the pendulum's reaction and the track forces, with the cart at rest
@@ -168,6 +168,9 @@ def balance(pr: Prepared, p: dict, active) -> Balance:
             held = held - (0.75 * m * gr * np.cos(th) * np.sin(th) - m * l * np.sin(th) * pr.b_thd ** 2)
         # stuck: static friction held it, |held| <= Fs; breakaway: |held| >= Fs (eq. 5)
         static = np.maximum(0.0, pr.b_kind * (np.abs(held) - fx.static_level(p, active)))
+        if 'backlash' in active:  # a cart crossing the play moves while its encoder stands still
+            static = np.where(np.abs(v[np.minimum(pr.b_idx // pr.q, len(v) - 1)]) >= rec.stick_velocity,
+                              0.0, static)
     return Balance(y, model, np.where(used, y - model, 0.0), used, pend, x, v, uf, static)
 
 
@@ -217,7 +220,10 @@ def fit(pr: Prepared, active, start: dict) -> Fit:
     dof = max(1, n - len(names))
     J = sol.jac
     try:
-        cov = np.linalg.pinv(J.T @ J) * float(r @ r) / dof
+        norm = np.linalg.norm(J, axis=0)
+        scale = np.where(norm > 0, norm, 1.0)
+        Js = J / scale  # columns of unit norm: the parameters' units differ by many decades
+        cov = np.linalg.pinv(Js.T @ Js) / np.outer(scale, scale) * float(r @ r) / dof
         std = np.sqrt(np.maximum(np.diag(cov), 0.0))
         std[np.linalg.norm(J, axis=0) == 0.0] = np.nan  # the data say nothing about it
     except np.linalg.LinAlgError:
@@ -278,16 +284,22 @@ def total_rms(pr: Prepared, f: Fit) -> float:
 
 
 def block_test(pr: Prepared, before: Fit, after: Fit) -> float:
-    """p-value that the squared validation residual did not drop (one-sided Wilcoxon signed-rank
-    test on its means over blocks of BLOCK_S seconds; robust to an effect confined to a few blocks)."""
+    """p-value that the squared validation residual did not drop: block bootstrap of its drop
+    summed over time blocks of BLOCK_S seconds (the blocks keep the residual's correlation; an
+    effect confined to a few blocks, e.g. reversals, still counts by its size). Every residual
+    (force balance, static friction, pendulum) counts in its time block."""
     r0 = residual_vector(pr, before.params, before.active)
     r1 = residual_vector(pr, after.params, after.active)
     d = r0 ** 2 - r1 ** 2
+    times = np.concatenate([pr.t, pr.t_full[pr.b_idx]] + ([pr.t] if pr.has_theta else []))
     nb = max(10, min(60, int(len(pr.t) * pr.dt / BLOCK_S)))
-    means = np.array([blk.mean() for blk in np.array_split(d, nb)])
-    if not np.any(means):
+    block = np.minimum(((times - pr.t[0]) / (pr.t[-1] - pr.t[0] + 1e-12) * nb).astype(int), nb - 1)
+    sums = np.bincount(block, d, nb)
+    if not np.any(sums):
         return 1.0
-    return float(wilcoxon(means, alternative='greater').pvalue)
+    rng = np.random.default_rng(0)
+    boot = sums[rng.integers(0, nb, (BOOTSTRAP, nb))].sum(axis=1)
+    return float((np.sum(boot <= 0.0) + 1) / (BOOTSTRAP + 1))
 
 
 def analyse(pr: Prepared, f: Fit) -> dict:
@@ -297,6 +309,14 @@ def analyse(pr: Prepared, f: Fit) -> dict:
     s = signature_scores(b.r[u], pr.t[u], b.x[u], b.v[u], b.u[u], pr.dt,
                          None if b.pendulum is None else b.pendulum[pr.inside])
     return {'whiteness': w, 'signatures': s}
+
+
+def explained(pr: Prepared, f: Fit) -> bool:
+    """True when the force residual is white and static friction is not violated beyond it."""
+    b = balance(pr, f.params, f.active)
+    rms = np.sqrt(np.mean(b.r[b.used] ** 2))
+    static_ok = not len(b.static) or np.sqrt(np.mean(b.static ** 2)) <= rms
+    return bool(static_ok and analyse(pr, f)['whiteness']['white'])
 
 
 def candidate_names(pr: Prepared, base: tuple, allowed=None) -> list[str]:
@@ -321,7 +341,7 @@ def identify(est: Record, val: Record, base_model: str = 'viscous', allowed=None
     base_fit = current
     tried = []
     for _ in range(max_rounds):
-        if analyse(pe, current)['whiteness']['white']:
+        if explained(pe, current):
             break
         ranked = []
         for name in candidate_names(pe, current.active, allowed):
@@ -352,3 +372,34 @@ def identify(est: Record, val: Record, base_model: str = 'viscous', allowed=None
             break
     return {'base_model': base_model, 'base_fit': base_fit, 'fit': current, 'tried': tried,
             'prepared': (pe, pv)}
+
+
+def identify_steady(plant, volts, vels, breakaway_volts) -> dict:
+    """The cart-alone appendix experiments through the same force balance.
+
+    Steady sliding (Table 5, x'' = 0): alpha V = (beta + eps) v + Fc, the coulomb effect's
+    sliding branch; breakaway on a ramp (Table 6): alpha V_s = Fs = Fc + Fs_excess, its static
+    branch. One bounded least-squares fit of (eps, Fc, Fs_excess) with standard errors;
+    F_N = M g. The residual of the sliding rows is returned against velocity.
+    """
+    V, v, Vs = (np.asarray(a, float) for a in (volts, vels, breakaway_volts))
+    active = ('coulomb',)
+
+    def fun(theta):
+        p = {'eps': theta[0], 'Fc': theta[1], 'Fs_excess': theta[2]}
+        slide = plant.alpha * V - plant.beta * v - fx.resisting_force(np.zeros_like(v), v, p, active, 1.0)
+        return np.concatenate([slide, plant.alpha * Vs - fx.static_level(p, active)])
+    sol = least_squares(fun, [1.0, 0.1, 0.1], bounds=([0, 0, 0], [1e3, 1e3, 1e3]))
+    r = sol.fun
+    cov = np.linalg.inv(sol.jac.T @ sol.jac) * float(r @ r) / max(1, len(r) - 3)
+    std = np.sqrt(np.diag(cov))
+    fn = plant.M * plant.g
+    rs = r[:len(v)]
+    return {'eps': float(sol.x[0]), 'eps_std': float(std[0]),
+            'mu_c': float(sol.x[1] / fn), 'mu_c_std': float(std[1] / fn),
+            'mu_s': float((sol.x[1] + sol.x[2]) / fn), 'mu_s_std': float(np.hypot(std[1], std[2]) / fn),
+            'sliding_residual_N': rs.tolist(), 'velocity_mps': v.tolist(),
+            'sliding_rms_N': float(np.sqrt(np.mean(rs ** 2))),
+            'breakaway_rms_N': float(np.sqrt(np.mean(r[len(v):] ** 2))),
+            'residual_velocity_correlation': float(np.corrcoef(rs, v)[0, 1]),
+            'residual_curvature_N': float(np.polyfit(v, rs, 2)[0] * np.ptp(v) ** 2 / 4)}
