@@ -29,7 +29,7 @@ from . import effects as fx
 from .dataio import Record
 from .residual import signature_scores, whiteness
 
-MIN_GAIN_PERCENT = 3.0
+MIN_GAIN_PERCENT = 1.0
 P_VALUE = 0.01
 BLOCK_S = 0.25
 BOOTSTRAP = 2000
@@ -63,7 +63,8 @@ class Prepared:
         self.has_theta = rec.theta is not None
         if self.has_theta:
             self.th, self.thd, self.thdd = self._derivatives(rec.theta)
-        self.uf = self.filt(self.u_full)
+        self.uf_full = sosfiltfilt(self.sos, self.u_full)
+        self.uf = self.uf_full[self.idx]
         self._breakaways(rec)
         self.inside = (self.t >= t[0] + EDGE_S) & (self.t <= t[-1] - EDGE_S)
         self.used = self.inside & ~self.near(np.abs(self.v) < rec.stick_velocity)
@@ -110,9 +111,6 @@ class Prepared:
             return stuck
         return np.convolve(stuck.astype(float), np.ones(2 * k + 1), 'same') > 0
 
-    def filt(self, y):
-        return sosfiltfilt(self.sos, y)[self.idx]
-
     def _derivatives(self, y):
         f = sosfiltfilt(self.sos, y)
         v = np.gradient(f, self.rec.t)
@@ -140,9 +138,10 @@ def balance(pr: Prepared, p: dict, active) -> Balance:
     rec = pr.rec
     if any(fx.EFFECTS[e].acts_on == 'input' for e in active):
         u = fx.input_effects(pr.t_full, pr.u_full, p, active)
-        uf = pr.filt(u)
+        uf_full = sosfiltfilt(pr.sos, u)
     else:
-        u, uf = pr.u_full, pr.uf
+        uf_full = pr.uf_full
+    uf = uf_full[pr.idx]
     y = rec.gain * uf
     x, v, a = pr.x, pr.v, pr.a
     if 'backlash' in active:
@@ -161,7 +160,9 @@ def balance(pr: Prepared, p: dict, active) -> Balance:
     static = np.zeros(0)
     if len(pr.b_idx):
         # held force: input less the pendulum's reaction and the track forces, with the cart at rest
-        held = rec.gain * u[pr.b_idx] - fx.position_force(pr.b_x, p, active)
+        # (filtered like the rest: a command spike too short to move the cart past one count is
+        # smoothed as the cart's inertia smooths it)
+        held = rec.gain * uf_full[pr.b_idx] - fx.position_force(pr.b_x, p, active)
         if pr.has_theta:
             m, l, gr = rec.pendulum
             th = pr.b_th - p.get('theta_bias', 0.0)
@@ -268,9 +269,13 @@ def errors(pr: Prepared, p: dict, active) -> dict:
             'samples': int(b.used.sum())}
 
 
-def resolved(pr: Prepared, name: str, p: dict) -> bool:
-    """False for a play below two encoder counts (that is quantization) and for a ripple
-    with fewer than five periods over the travel (the motion's own periodicity looks alike)."""
+def resolved(pr: Prepared, name: str, f: Fit) -> bool:
+    """False for a play below two encoder counts (that is quantization), for a ripple with
+    fewer than five periods over the travel (the motion's own periodicity looks alike) and for
+    a deadzone whose force is below the residual's RMS."""
+    p = f.params
+    if name == 'deadzone':
+        return pr.rec.gain * p['dz'] > errors(pr, p, f.active)['rms']
     if name == 'backlash':
         return p['gap'] > 2 * pr.resolution
     if name == 'cogging':
@@ -360,7 +365,7 @@ def identify(est: Record, val: Record, base_model: str = 'viscous', allowed=None
             ee0, ee1 = total_rms(pe, current), total_rms(pe, f)
             gain = 100 * (ev0 - ev1) / ev0
             pval = block_test(pv, current, f)
-            resolvable = resolved(pe, name, f.params)
+            resolvable = resolved(pe, name, f)
             ok = bool(f.bic < current.bic and gain > min_gain_percent and pval < P_VALUE and resolvable)
             tried.append({'name': name, 'estimation_gain_percent': 100 * (ee0 - ee1) / ee0,
                           'validation_gain_percent': gain, 'validation_p': pval,
