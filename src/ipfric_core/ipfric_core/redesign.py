@@ -71,6 +71,15 @@ def identified_truth(r: dict, dt: float) -> PlantTruth:
     return PlantTruth(**vals)
 
 
+def design_friction(friction: FrictionParams) -> FrictionParams:
+    """The law the gain is designed on: the identified sticking law, linearized with the slope of
+    tanh(delta v) (section 3.1, the design of gain (23)); a bristle model is designed on its
+    static map (exponential), since the bristle state is not measured."""
+    if friction.model == 'dynamic':
+        return friction.replace(model='exponential', smoothing='none')
+    return friction
+
+
 def designed_gain(plant: PlantParams, friction: FrictionParams, Q, R: float) -> list:
     return [float(k) for k in design(plant, friction, Q, R).gain[:4]]
 
@@ -83,14 +92,14 @@ def export_scenario(path: str | Path, r: dict, base: Scenario, rig: Scenario | N
     """Write the identified scenario to ``path`` (and ``<stem>_on_rig.yaml`` when ``rig`` is given).
 
     sim_node: ``base``'s settings with the identified friction and effects; controller_node:
-    the gain designed (LQR, ``base``'s Q and R) on the identified friction. With ``rig``, a
+    the gain designed (LQR, ``base``'s Q and R) on the identified friction (:func:`design_friction`). With ``rig``, a
     second file runs that gain on the rig's own sim_node (the plant you ran on).
     """
     path = Path(path)
     friction = identified_friction(r)
     truth = identified_truth(r, base.sample_period)
     c = base.controller
-    gain = designed_gain(base.plant, friction, c.Q, c.R)
+    gain = designed_gain(base.plant, design_friction(friction), c.Q, c.R)
     sim = {k: v for k, v in base.to_dict()['sim'].items()}
     sim.update(plant=base.to_dict()['plant'], friction=friction.to_dict(),
                plant_truth={k: v for k, v in truth.to_dict().items() if v != getattr(PlantTruth(), k)})
