@@ -344,7 +344,7 @@ def identify(est: Record, val: Record, base_model: str = 'viscous', allowed=None
         start = best_fit(pe, tuple(active[:active.index(e) + 1]), starts(pe, e, start, active[:active.index(e)])).params
     current = fit(pe, active, start) if active else lin
     base_fit = current
-    tried = []
+    tried, steps = [], [current]
     for _ in range(max_rounds):
         if explained(pe, current):
             break
@@ -371,11 +371,12 @@ def identify(est: Record, val: Record, base_model: str = 'viscous', allowed=None
                           'validation_gain_percent': gain, 'validation_p': pval,
                           'bic_drop': current.bic - f.bic, 'kept': ok})
             if ok:
+                steps.append(f)
                 current, kept = f, True
                 break
         if not kept:
             break
-    return {'base_model': base_model, 'base_fit': base_fit, 'fit': current, 'tried': tried,
+    return {'base_model': base_model, 'base_fit': base_fit, 'fit': current, 'tried': tried, 'steps': steps,
             'prepared': (pe, pv)}
 
 

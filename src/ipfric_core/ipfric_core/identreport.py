@@ -100,9 +100,8 @@ def figures(res: dict, out: Path) -> list[str]:
         a.set(xlabel='lag (s)', title=lab)
         a.legend()
     files.append(_save(fig, out / 'autocorrelation.png'))
-    prev = base
-    for name in [e for e in fit.active if e not in base.active]:
-        bp = balance(pe, prev.params, prev.active)
+    for prev, name in zip(res['steps'], [e for e in fit.active if e not in base.active]):
+        bp = balance(pe, prev.params, prev.active)  # the residual before the effect was added
         var, label = _signature_axis(name, bp, pe)
         fig, ax = plt.subplots(figsize=(6, 4))
         ax.plot(var, bp.r[bp.used], '.', ms=2)
