@@ -6,15 +6,19 @@ decimated to five samples per corner period. The force balance of
 :mod:`ipfric_core.effects` is fitted by bounded nonlinear least squares
 (``scipy.optimize.least_squares``, trust region reflective); the standard errors come
 from the Jacobian at the optimum. Samples with |x'| below ``Record.stick_velocity``
-(the cart held by static friction: the friction force there is unknown) and the
-filter's start-up at both ends are left out.
+(the cart held by static friction: the friction force there is unknown), widened by one
+corner period, and the filter's start-up at both ends are left out of the force balance;
+static friction enters as inequalities on the stretches where the encoder stands still
+(held force <= Fs while stuck, >= Fs at the breakaway). With the pendulum, its own
+equation (no unknown parameter) is a further residual block.
 
 Search (:func:`identify`): fit the base model; then, round by round, refit with each
 remaining candidate effect, rank the candidates by how much estimation error each
 removes, and keep the best only if it pays on the validation data: the Bayesian
 information criterion on estimation drops, the validation RMS drops by more than
 ``min_gain_percent``, and the drop is significant (p < P_VALUE in a block bootstrap
-over quarter-second blocks). Stop when the residual is white or nothing pays.
+over quarter-second blocks), and the effect is resolvable (:func:`resolved`). Stop when
+the residual is white or nothing pays.
 """
 from __future__ import annotations
 
@@ -27,6 +31,7 @@ from scipy.signal import butter, sosfiltfilt
 
 from . import effects as fx
 from .dataio import Record
+from .params import ConfigError
 from .residual import signature_scores, whiteness
 
 MIN_GAIN_PERCENT = 1.0
@@ -69,7 +74,6 @@ class Prepared:
         self.inside = (self.t >= t[0] + EDGE_S) & (self.t <= t[-1] - EDGE_S)
         self.used = self.inside & ~self.near(np.abs(self.v) < rec.stick_velocity)
         if self.used.sum() < 50:
-            from .params import ConfigError
             raise ConfigError(f'{rec.name}: only {int(self.used.sum())} moving samples (|x\'| >= '
                               f'{rec.stick_velocity:g} m/s); the data hardly move the axis')
         self.n_used = int(self.used.sum())
@@ -332,7 +336,6 @@ def candidate_names(pr: Prepared, base: tuple, allowed=None) -> list[str]:
 def identify(est: Record, val: Record, base_model: str = 'viscous', allowed=None,
              max_rounds: int = 6, min_gain_percent: float = MIN_GAIN_PERCENT) -> dict:
     """Fit ``base_model``, then search the effect library; returns the full result."""
-    from .params import ConfigError
     if base_model not in fx.BASE_MODELS:
         raise ConfigError(f'base model: {base_model!r} is not one of {", ".join(fx.BASE_MODELS)}')
     pe, pv = Prepared(est), Prepared(val)
