@@ -103,9 +103,11 @@ def test_undeclared_effect_is_found_with_its_parameters(effect, truth, expect):
         or effect == 'backlash'
 
 
-def test_angle_sensor_bias_found_in_dithered_closed_loop():
+def test_angle_sensor_bias_found_in_dithered_closed_loop(tmp_path):
     sc = load_scenario(ROOT / 'config' / 'fig7_old_gain_viscous.yaml')
     biased = dithered_run(replace(sc, truth=PlantTruth(bias_theta_rad=0.01)), 12.0, 1.0)
+    back = load_csv(write_csv(tmp_path / 'pendulum.csv', biased), PLANT)
+    assert np.allclose(back.theta, biased.theta) and back.normal_force == pytest.approx(PLANT.normal_force)
     fit, res = search(biased, 'viscous')
     assert fit.active == ('sensor_bias',), res['tried']
     assert fit.params['theta_bias'] == pytest.approx(0.01, rel=0.05)
