@@ -62,6 +62,17 @@ def test_csv_bad_input_is_refused_with_the_problem(tmp_path, clean, mangle, mess
         load_csv(tmp_path / 'bad.csv', PLANT)
 
 
+def test_angle_in_degrees_and_uneven_sampling_are_refused(tmp_path, clean):
+    deg = np.column_stack([clean.t, clean.x, clean.u, np.full(len(clean.t), 15.0)])
+    np.savetxt(tmp_path / 'deg.csv', deg, delimiter=',', header='t,x,voltage,theta', comments='')
+    with pytest.raises(ConfigError, match='degrees'):
+        load_csv(tmp_path / 'deg.csv', PLANT)
+    uneven = np.column_stack([clean.t ** 1.2, clean.x, clean.u])
+    np.savetxt(tmp_path / 'uneven.csv', uneven, delimiter=',', header='t,x,voltage', comments='')
+    with pytest.raises(ConfigError, match='not evenly spaced'):
+        load_csv(tmp_path / 'uneven.csv', PLANT)
+
+
 def test_emps_loader(data_dir):
     rec = load_emps(data_dir / 'emps' / 'DATA_EMPS.mat')
     assert len(rec.t) == 24841 and rec.dt == pytest.approx(1e-3, rel=1e-4)

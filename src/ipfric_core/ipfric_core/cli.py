@@ -182,18 +182,19 @@ def cmd_identify(args) -> int:
         print(f'cart amplitude {b["x_p2p_m"] * 1000:.2f} mm before, {a["x_p2p_m"] * 1000:.2f} mm after; '
               f'report {out["report"]}; scenarios {out["export"]["scenario"]}, {out["export"]["on_rig"]}')
         return 0
-    from .params import load_yaml
-    if 'sim_node' in load_yaml(args.plant):
+    from .params import PlantParams, load_yaml
+    plant = None  # a bag then uses the plant of its stored scenario, the rest Table 1
+    if args.plant and 'sim_node' in load_yaml(args.plant):
         from .scenario import load_scenario
         plant = load_scenario(args.plant).plant
-    else:
+    elif args.plant:
         plant = load_paper_config(args.plant).plant
     if args.data == 'paper':
         from .estimation import load_table5, load_table6
         from .identify import identify_steady
         d = Path(args.tables)
         V, v, _, _, aside = load_table5(d / 'table5_constant_voltage.csv')
-        rep = identify_steady(plant, V, v, load_table6(d / 'table6_breakaway_voltage.csv'))
+        rep = identify_steady(plant or PlantParams(), V, v, load_table6(d / 'table6_breakaway_voltage.csv'))
         rep['runs_set_aside'] = [{'voltage_V': a, 'value_mps': b, 'row_average_mps': c} for a, b, c in aside]
         if args.json:
             _print_json(rep)
@@ -312,8 +313,8 @@ def build_parser() -> argparse.ArgumentParser:
     i.add_argument('--base', default='viscous', help='declared base model: viscous, coulomb, exponential, '
                    'dynamic (default %(default)s)')
     i.add_argument('--effects', help='comma-separated candidate effects (default: the whole library)')
-    i.add_argument('--plant', default=str(DEFAULT_CONFIG), help='plant constants: paper YAML or a scenario '
-                   '(default %(default)s)')
+    i.add_argument('--plant', help='plant constants: paper YAML or a scenario (default: a bag\'s stored '
+                   'scenario, else Table 1)')
     i.add_argument('--columns', help='CSV column mapping, e.g. t=time_s,x=cart_m,voltage=u_V,theta=angle_rad')
     i.add_argument('--cart-alone', action='store_true', help='ignore the angle of a bag (pendulum off)')
     i.add_argument('--tables', default=str(Path(DEFAULT_DATA) / 'paper'), help='directory of Tables 5-6 '

@@ -177,11 +177,14 @@ def load_emps(path: str | Path) -> Record:
                                normal_force=1.0, stick_velocity=0.0, cutoff_hz=20.0))
 
 
-def load(path: str | Path, plant: PlantParams, columns: dict | None = None, cart_alone: bool = False) -> Record:
-    """Pick the loader from the file: .csv, .mat (EMPS), else a bag (directory or .mcap)."""
+def load(path: str | Path, plant: PlantParams | None, columns: dict | None = None,
+         cart_alone: bool = False) -> Record:
+    """Pick the loader from the file: .csv, .mat (EMPS), else a bag (directory or .mcap).
+
+    ``plant`` None: a bag's stored scenario, Table 1 for a CSV."""
     p = Path(path)
     if p.suffix.lower() == '.csv':
-        return load_csv(p, plant, columns)
+        return load_csv(p, plant or PlantParams(), columns)
     if p.suffix.lower() == '.mat':
         return load_emps(p)
     if not p.exists():
