@@ -55,8 +55,8 @@ EFFECTS = {e.name: e for e in (
            'sliding level; a transient after each reversal', requires=('coulomb',)),
     Effect('asymmetry', (Param('dFc', 'N', -1e4, 1e4), Param('dFv', 'N s/m', -1e4, 1e4)), 'friction',
            'direction', 'direction-dependent friction: Coulomb Fc + dFc forward, Fc - dFc backward '
-           '(a constant force while sliding) and viscous eps + dFv sgn(x\'); the residual differs by '
-           'direction'),
+           '(a constant force while sliding) and viscous eps + dFv sgn(x\'); the residual is even in '
+           'x\' (the same sign both ways) where friction misfits are odd'),
     Effect('offset', (Param('F0', 'N', -1e4, 1e4),), 'force', 'mean',
            'a constant force (slope of the track, amplifier offset): the residual has a mean'),
     Effect('cogging', (Param('cog_sin', 'N', -1e4, 1e4), Param('cog_cos', 'N', -1e4, 1e4),

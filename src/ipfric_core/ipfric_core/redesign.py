@@ -17,6 +17,7 @@ import yaml
 
 from .closedloop import run_closed_loop
 from .dataio import trajectory_record
+from .effects import BASE_MODELS
 from .identify import identify
 from .identreport import write_report
 from .lqr import design
@@ -29,9 +30,7 @@ from .scenario import Scenario, load_scenario
 def identified_friction(r: dict) -> FrictionParams:
     """The paper's friction model closest to the identified one (result dict of a search)."""
     f = r['friction']
-    eff = set(r['effects_added']) | set({'viscous': (), 'coulomb': ('coulomb',),
-                                         'exponential': ('coulomb', 'stribeck'),
-                                         'dynamic': ('coulomb', 'stribeck', 'presliding')}[r['base_model']])
+    eff = set(r['effects_added']) | set(BASE_MODELS[r['base_model']])
     data = {'model': 'viscous', 'eps': max(0.0, f['eps'])}
     if 'coulomb' in eff:
         data.update(model='coulomb', mu_c=f['mu_c'], mu_s=f['mu_s'])

@@ -111,7 +111,7 @@ def best_lag(r: np.ndarray, du: np.ndarray, dt: float, max_lag: int = MAX_LAG) -
 
 SIGNATURES = {
     'velocity_sign': 'sgn(x\')', 'speed': '|x\'| (by direction)', 'reversal': 'time since reversal',
-    'direction': 'direction of motion', 'mean': 'constant', 'position': 'position (spectrum)',
+    'direction': '|x\'| unsigned (even in x\')', 'mean': 'constant', 'position': 'position (spectrum)',
     'voltage': 'input u', 'lag': 'lag to the input rate', 'pendulum_mean': 'pendulum-equation mean',
 }
 
@@ -127,7 +127,7 @@ def signature_scores(r, t, x, v, u, dt, pendulum_residual=None) -> dict:
         'velocity_sign': eta_squared(r, s, 2),
         'speed': eta_squared(r * s, np.abs(v)),
         'reversal': eta_squared(r * s, np.minimum(rev, 0.5)),
-        'direction': eta_squared(r, s, 2),
+        'direction': eta_squared(r, np.abs(v)),
         'mean': float(np.mean(r) ** 2 / ms),
         'position': pos,
         'voltage': eta_squared(r, u),
