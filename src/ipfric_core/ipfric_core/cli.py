@@ -312,6 +312,101 @@ def cmd_sweep(args) -> int:
     return 0
 
 
+def cmd_identify(args) -> int:
+    """Identification on measured data, the paper tables, or the closed-loop redesign."""
+    from .effects import BASE_MODELS, EFFECTS
+    if args.loop:
+        from .redesign import close_the_loop
+        out = close_the_loop(args.loop, args.out, args.duration, args.base, not args.no_plots)
+        if args.json:
+            _print_json(out)
+            return 0
+        b, a = out['before'], out['after']
+        print(f'{args.loop}: gain {[round(k, 2) for k in out["gain_before"]]} -> {b["class"]}, cart p2p '
+              f'{b["x_p2p_m"] * 1000:.2f} mm, angle p2p {math.degrees(b["theta_p2p_rad"]):.3f} deg')
+        idf = out['identified']
+        print(f'identified: {idf["base_model"]} + {", ".join(idf["effects_added"]) or "nothing"}; '
+              + ', '.join(f'{k} {v:.4g}' for k, v in idf['friction'].items()))
+        print(f'redesigned gain {[round(k, 2) for k in out["gain_after"]]} -> {a["class"]}, cart p2p '
+              f'{a["x_p2p_m"] * 1000:.2f} mm, angle p2p {math.degrees(a["theta_p2p_rad"]):.3f} deg')
+        print(f'cart amplitude {b["x_p2p_m"] * 1000:.2f} mm before, {a["x_p2p_m"] * 1000:.2f} mm after; '
+              f'report {out["report"]}; scenarios {out["export"]["scenario"]}, {out["export"]["on_rig"]}')
+        return 0
+    from .params import PlantParams, load_yaml
+    plant = None  # a bag then uses the plant of its stored scenario, the rest Table 1
+    if args.plant and 'sim_node' in load_yaml(args.plant):
+        from .scenario import load_scenario
+        plant = load_scenario(args.plant).plant
+    elif args.plant:
+        plant = load_paper_config(args.plant).plant
+    if args.data == 'paper':
+        from .estimation import load_table5, load_table6
+        from .identify import identify_steady
+        d = Path(args.tables)
+        V, v, _, _, aside = load_table5(d / 'table5_constant_voltage.csv')
+        rep = identify_steady(plant or PlantParams(), V, v, load_table6(d / 'table6_breakaway_voltage.csv'))
+        rep['runs_set_aside'] = [{'voltage_V': a, 'value_mps': b, 'row_average_mps': c} for a, b, c in aside]
+        if args.json:
+            _print_json(rep)
+            return 0
+        print('Tables 5 and 6 through the force balance (coulomb effect, F_N = M g):')
+        for k in ('mu_c', 'eps', 'mu_s'):
+            print(f'  {k:<5} {rep[k]:.5f} +/- {rep[k + "_std"]:.5f}')
+        print(f'  sliding residual RMS {rep["sliding_rms_N"]:.4f} N, breakaway residual RMS '
+              f'{rep["breakaway_rms_N"]:.4f} N, curvature of the residual over the velocity range '
+              f'{rep["residual_curvature_N"]:+.4f} N')
+        return 0
+    from .dataio import load
+    from .identify import identify
+    from .identreport import write_report
+    columns = {}
+    for item in args.columns.split(',') if args.columns else []:
+        key, _, name = item.partition('=')
+        if not name:
+            raise ConfigError(f'--columns: {item!r} is not NAME=HEADER (names t, x, voltage, theta)')
+        columns[key.strip()] = name.strip()
+    rec = load(args.data, plant, columns, args.cart_alone)
+    allowed = None
+    if args.effects:
+        allowed = [e.strip() for e in args.effects.split(',')]
+        bad = [e for e in allowed if e not in EFFECTS]
+        if bad:
+            raise ConfigError(f'--effects: unknown effect(s) {", ".join(bad)}; allowed: {", ".join(EFFECTS)}')
+    if args.validation:
+        est, val = rec, load(args.validation, plant, columns, args.cart_alone)
+    else:
+        if not 0.2 <= args.split <= 0.9:
+            raise ConfigError(f'--split: {args.split:g} is out of range; allowed [0.2, 0.9]')
+        est, val = rec.split(args.split)
+    if args.base not in BASE_MODELS:
+        raise ConfigError(f'--base: {args.base!r} is not one of {", ".join(BASE_MODELS)}')
+    r = write_report(identify(est, val, args.base, allowed), args.out, not args.no_plots)
+    if args.export:
+        from .redesign import export_scenario
+        from .scenario import load_scenario
+        r['export'] = export_scenario(args.export, r, load_scenario(args.scenario),
+                                      load_scenario(args.rig) if args.rig else None)
+    if args.json:
+        _print_json(r)
+        return 0
+    print(f'{r["data"]["estimation"]} / {r["data"]["validation"]}: base {r["base_model"]}, effects added: '
+          f'{", ".join(r["effects_added"]) or "none"}')
+    for tag in ('error_before', 'error_after'):
+        e = r[tag]
+        print(f'  {tag.replace("_", " "):<13} estimation {e["estimation"]["relative_percent"]:.3f} % '
+              f'(RMS {e["estimation"]["rms"]:.4g} N), validation {e["validation"]["relative_percent"]:.3f} % '
+              f'(RMS {e["validation"]["rms"]:.4g} N)')
+    for t in r['effects_tried']:
+        print(f'  tried {t["name"]:<11} validation gain {t["validation_gain_percent"]:7.2f} %  '
+              f'p {t["validation_p"]:.2g}  {"kept" if t["kept"] else "rejected"}')
+    print('  ' + ', '.join(f'{k} {p["value"]:.5g} +/- {p["std"]:.2g} {p["unit"]}' for k, p in r['params'].items()))
+    print(f'  residual white: before {r["residual_white_before"]}, after {r["residual_white_after"]}; '
+          f'report {Path(args.out) / "report.md"}')
+    if args.export:
+        print(f'  exported {r["export"]["scenario"]}' + (f' and {r["export"]["on_rig"]}' if args.rig else ''))
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog='ipfric', description='Friction and the inverted pendulum: '
                                 'design, simulation, ROS 2 closed loop and analysis.')
@@ -377,6 +472,34 @@ def build_parser() -> argparse.ArgumentParser:
     w.add_argument('--cutoff-hz', type=float, default=None,
                    help='override the controller\'s velocity filter corner [Hz] (0 = raw difference)')
     w.add_argument('--out', required=True, help='directory for cells.csv, map.png, summary.json')
+    i = add('identify', cmd_identify, 'identify the cart\'s friction and undeclared effects from measured '
+            'data (run bag, CSV, EMPS .mat, or "paper" for Tables 5-6): base fit, residual analysis, '
+            'greedy effect search kept only when it pays on validation data; report, export, redesign')
+    i.add_argument('data', nargs='?', default='paper', help='run directory / bag / .mcap, .csv (t,x,voltage[,theta]), '
+                   'EMPS .mat, or "paper" (default %(default)s)')
+    i.add_argument('--validation', help='second file for validation (default: the last part of DATA)')
+    i.add_argument('--split', type=float, default=0.6, help='estimation share of DATA when no --validation '
+                   '(default %(default)s)')
+    i.add_argument('--base', default='viscous', help='declared base model: viscous, coulomb, exponential, '
+                   'dynamic (default %(default)s)')
+    i.add_argument('--effects', help='comma-separated candidate effects (default: the whole library)')
+    i.add_argument('--plant', help='plant constants: paper YAML or a scenario (default: a bag\'s stored '
+                   'scenario, else Table 1)')
+    i.add_argument('--columns', help='CSV column mapping, e.g. t=time_s,x=cart_m,voltage=u_V,theta=angle_rad')
+    i.add_argument('--cart-alone', action='store_true', help='ignore the angle of a bag (pendulum off)')
+    i.add_argument('--tables', default=str(Path(DEFAULT_DATA) / 'paper'), help='directory of Tables 5-6 '
+                   '(default %(default)s)')
+    i.add_argument('--out', default='runs/identify', help='report directory (default %(default)s)')
+    i.add_argument('--no-plots', action='store_true', help='no PNG figures')
+    i.add_argument('--export', help='write the identified plant and the gain designed on it as a scenario YAML')
+    i.add_argument('--scenario', default=str(REPO_ROOT / 'config' / 'default.yaml'),
+                   help='settings, Q and R for --export (default %(default)s)')
+    i.add_argument('--rig', help='with --export: also write <export>_on_rig.yaml, this scenario\'s rig with '
+                   'the new gain')
+    i.add_argument('--loop', metavar='SCENARIO', help='closed-loop redesign offline: run SCENARIO, identify on '
+                   'its measured data, redesign, run again; prints the amplitudes before and after')
+    i.add_argument('--duration', type=float, default=20.0, help='--loop: simulated seconds per run '
+                   '(default %(default)s)')
     return p
 
 

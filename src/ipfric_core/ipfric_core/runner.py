@@ -183,7 +183,7 @@ class Run:
                  timeout: float | None = None, grace: float = 20.0, sim_params: dict | None = None,
                  stop_wait: float = 20.0):
         self.config = Path(config)
-        self.out = Path(out)
+        self.out = Path(out).resolve()  # the nodes run with cwd = out
         self.duration = duration
         self.domain = domain
         self.timeout = timeout
