@@ -122,7 +122,7 @@ class ControllerNode(Node):
             if p.name == 'delay':
                 self.controller.set_delay(value)
             elif p.name == 'gain':
-                self.controller.gain = [float(k) for k in value]
+                self.controller.gain = tuple(float(k) for k in value)
                 if self.ready:
                     self._publish_gain()
             elif p.name == 'cutoff_hz':
