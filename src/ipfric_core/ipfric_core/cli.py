@@ -162,6 +162,21 @@ def cmd_sweep(args) -> int:
     return 0
 
 
+def cmd_bench(args) -> int:
+    sys.path.insert(0, str(REPO_ROOT))
+    from bench.run import run_all
+    results = Path(args.results) if args.results else (
+        REPO_ROOT / 'runs' / 'bench-quick' / 'RESULTS.md' if args.quick else REPO_ROOT / 'bench' / 'RESULTS.md')
+    out = run_all(args.quick, args.realtime_duration, results,
+                  progress=(lambda msg: print(msg, file=sys.stderr)))
+    if args.json:
+        _print_json(out)
+        return 0
+    print(out['table'])
+    print(f'written: {out["results"]}')
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog='ipfric', description='Friction and the inverted pendulum: '
                                 'design, simulation, ROS 2 closed loop and analysis.')
@@ -207,6 +222,13 @@ def build_parser() -> argparse.ArgumentParser:
     w.add_argument('--smoothing', choices=('none', 'tanh'), default=None, help='override the friction smoothing')
     w.add_argument('--workers', type=int, default=None, help='processes (default: all cores)')
     w.add_argument('--out', required=True, help='directory for cells.csv, map.png, summary.json')
+    b = add('bench', cmd_bench, 'benchmarks beside their references (scipy, MuJoCo, raw rclpy): offline closed '
+            'loop, Figure-11 sweep, ROS lockstep and realtime loops, analyze, identify; table and bench/RESULTS.md')
+    b.add_argument('--quick', action='store_true', help='tiny sizes: check that every benchmark runs (no targets)')
+    b.add_argument('--realtime-duration', type=float, default=600.0,
+                   help='seconds of the realtime ROS run whose bag analyze reads (default %(default)s)')
+    b.add_argument('--results', default=None, help='where to write the table (default bench/RESULTS.md, '
+                   'runs/bench-quick/RESULTS.md with --quick)')
     return p
 
 

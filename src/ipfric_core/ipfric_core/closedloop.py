@@ -74,6 +74,12 @@ def run_closed_loop(rig: Rig, controller: StateFeedback, duration: float,
     return Trajectory(t[:m], st[:m], meas[:m], volt[:m], fric[:m], stuck[:m], reason)
 
 
+def warm_up(scenario) -> None:
+    """Load the compiled functions the python engine calls (numba compiles them, or reads
+    its cache, on first use), so that a ROS node's first real sample does not wait for it."""
+    run_closed_loop(scenario.make_rig(), scenario.make_controller(), 0.002, engine='python')
+
+
 def _run_python(rig, controller, n, t, st, meas, volt, fric, stuck):
     reason = 'duration'
     k = 0
