@@ -10,7 +10,7 @@ import json
 import math
 import os
 import platform
-import resource
+import shutil
 import statistics
 import subprocess
 import sys
@@ -256,15 +256,16 @@ def run_all(quick: bool = False, realtime_s: float = 600.0, results: Path | None
     """Run every benchmark; write the table with the machine's description to ``results``."""
     info = machine()
     rows = []
-    with tempfile.TemporaryDirectory(prefix='ipfric-bench-') as tmp:
-        for name, fn in (('closed loop', lambda: bench_closed_loop(quick)), ('sweep', lambda: bench_sweep(quick))):
-            progress(f'[bench] {name} ...')
-            rows += fn()
-        progress('[bench] ROS lockstep, rclpy round trip, realtime ...')
-        ros_rows, bag = bench_ros(quick, 2.0 if quick else realtime_s, Path(tmp))
-        rows += ros_rows
-        progress('[bench] analyze ...')
-        rows += bench_analyze(bag, (2.0 if quick else realtime_s) / 60)
+    work = REPO_ROOT / 'runs' / ('bench-quick' if quick else 'bench') / 'work'  # the ROS runs, kept
+    shutil.rmtree(work, ignore_errors=True)
+    for name, fn in (('closed loop', lambda: bench_closed_loop(quick)), ('sweep', lambda: bench_sweep(quick))):
+        progress(f'[bench] {name} ...')
+        rows += fn()
+    progress('[bench] ROS lockstep, rclpy round trip, realtime ...')
+    ros_rows, bag = bench_ros(quick, 2.0 if quick else realtime_s, work)
+    rows += ros_rows
+    progress('[bench] analyze ...')
+    rows += bench_analyze(bag, (2.0 if quick else realtime_s) / 60)
     progress('[bench] identify ...')
     rows += bench_identify(quick)
     info['load_average_at_end'] = os.getloadavg()
