@@ -3,10 +3,11 @@ import math
 
 import numpy as np
 import pytest
+from numpy.lib.stride_tricks import sliding_window_view
 
 from ipfric_core import paper
 from ipfric_core.closedloop import run_closed_loop
-from ipfric_core.oscillation import classify, crossing_period, spectral_period
+from ipfric_core.oscillation import classify, crossing_period, spectral_period, window_ptp
 from ipfric_core.scenario import scenario_from_ros_params
 
 PLANT = {'M': 0.815, 'm': 0.21, 'l': 0.305, 'g': 9.8, 'alpha': 1.7189, 'beta': 7.682}
@@ -55,3 +56,9 @@ def test_growing_oscillation_is_recognised():
     t = np.arange(0, 20, 1e-3)
     x = 1e-3 * np.exp(0.2 * t) * np.sin(2 * np.pi * t)
     assert classify(t, x, 0.1 * x).cls == 'growing'
+
+
+@pytest.mark.parametrize('n', [1, 2, 7, 50])
+def test_window_ptp_is_the_sliding_peak_to_peak(n):
+    x = np.random.default_rng(n).normal(size=300)
+    np.testing.assert_array_equal(window_ptp(x, n), np.ptp(sliding_window_view(x, n), axis=1))

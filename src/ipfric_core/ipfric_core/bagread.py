@@ -169,7 +169,8 @@ def _scan(b, pos, kinds, counts, js, cmd, tru, n):
 class _Reader:
     """Streams one MCAP file: chunk by chunk (memory: one chunk plus the arrays kept)."""
 
-    def __init__(self):
+    def __init__(self, keep):
+        self.keep = keep
         self.schemas, self.channels, self.decoders = {}, {}, {}
         self.factory = DecoderFactory()
         self.kinds = np.zeros(65536, np.int8)
@@ -189,7 +190,8 @@ class _Reader:
         elif isinstance(rec, Channel):
             self.channels[rec.id] = rec
             topic = rec.topic.lstrip('/')
-            self.kinds[rec.id] = SCANNED.get(topic, PYTHON if topic in DECODED else SKIP)
+            kind = SCANNED.get(topic, PYTHON if topic in DECODED else SKIP)
+            self.kinds[rec.id] = kind if kind != SKIP and (topic in self.keep or kind == PYTHON) else SKIP
         elif isinstance(rec, Metadata):
             if 'ipfric.config' in rec.metadata:
                 self.config = json.loads(rec.metadata['ipfric.config'])
@@ -268,10 +270,14 @@ class _Reader:
                 return 'chunk records cut short'
 
 
-def read_run(path: str | Path) -> RunData:
-    """Stream the run's bag into arrays."""
+def read_run(path: str | Path, keep=tuple(SCANNED)) -> RunData:
+    """Stream the run's bag into arrays.
+
+    ``keep``: the sample-rate topics whose arrays to fill (joint_states, voltage_command,
+    plant_state); the others are only counted and their arrays left empty.
+    """
     f = mcap_file(path)
-    r = _Reader()
+    r = _Reader(set(keep) | {'joint_states'})
     with open(f, 'rb') as fh:
         try:
             detail = r.read(fh)

@@ -9,7 +9,7 @@ import math
 from dataclasses import asdict, dataclass
 
 import numpy as np
-from numpy.lib.stride_tricks import sliding_window_view
+from scipy.ndimage import maximum_filter1d, minimum_filter1d
 
 CLASSES = ('settled', 'limit_cycle', 'growing', 'fallen')
 
@@ -117,12 +117,19 @@ def classify(t, x, theta, resolution=(4.54e-5, 1.534e-3), fallen_angle: float = 
     return Oscillation(cls, onset, xp, thp, pc, ps, 1.0 / pc if pc else None, stick, window_span)
 
 
+def window_ptp(x: np.ndarray, n: int) -> np.ndarray:
+    """Peak-to-peak of every window x[i:i+n], i = 0 .. len(x) - n, in O(len(x))."""
+    x = np.asarray(x, float)
+    full = maximum_filter1d(x, n) - minimum_filter1d(x, n)   # centred windows
+    return full[n // 2:n // 2 + len(x) - n + 1]
+
+
 def _onset(t, x, half_p2p, span) -> float:
     """First time after which the cart's envelope over ``span`` [s] stays above half the final p2p."""
     dt = float(np.median(np.diff(t)))
     n = max(1, int(round(span / dt)))
     if len(x) <= n:
         return float(t[0])
-    env = np.ptp(sliding_window_view(x, n), axis=1)
+    env = window_ptp(x, n)
     low = np.nonzero(env < half_p2p)[0]
     return float(t[low[-1] + n]) if len(low) and low[-1] + n < len(t) else float(t[0])
