@@ -29,7 +29,7 @@ class ScipySimulator:
         self.n = model.n_states
         self.y = np.zeros(5)
         self.y[:len(state0)] = state0
-        self.stuck, self.d, self.t, self.events = False, 0.0, 0.0, 0
+        self.stuck, self.d, self.t = False, 0.0, 0.0
         self.hybrid = sticks(self.fp)
         self.lim = static_limit(self.fp)
 

@@ -214,8 +214,6 @@ class Simulator:
         Forces on the cart the friction model does not know (:func:`plant.undeclared_force`).
     """
 
-    MAX_EVENTS = MAX_EVENTS
-
     def __init__(self, model: CartPendulum, state0, substep: float = 2.5e-4,
                  extra_force: tuple = NO_EXTRA_FORCE):
         self.model = model
@@ -236,11 +234,6 @@ class Simulator:
     def stuck(self) -> bool:
         """True while static friction holds the cart."""
         return self._mode[0] != 0.0
-
-    @property
-    def direction(self) -> float:
-        """Sign of motion a sticking law uses while sliding (0 before the first motion)."""
-        return self._mode[1]
 
     @property
     def events(self) -> int:
