@@ -17,9 +17,9 @@ import math
 
 import mujoco
 import numpy as np
-from numba import njit
 
 from ipfric_core.closedloop import Trajectory
+from ipfric_core.compiled import compiled
 from ipfric_core.controller import feedback, filter_coefficient, filtered_rate
 from ipfric_core.encoder import quantize
 
@@ -55,7 +55,7 @@ def model_xml(scenario, h: float, sigma0: float, integrator: str = 'Euler') -> s
                        Fs=f.mu_s * fn, vs=f.v_s)
 
 
-@njit(cache=True)
+@compiled
 def _control(k, q, meas, history, a, dt, resolution, gain, delay, vlimit):
     """Encoder reading, velocity filter, delay and feedback of sample k (as StateFeedback)."""
     mx, mth = quantize(q[0], resolution[0]), quantize(q[1], resolution[1])

@@ -23,8 +23,8 @@ from mcap.opcode import Opcode
 from mcap.records import Channel, Chunk, Message, Metadata, Schema
 from mcap.stream_reader import get_chunk_data_stream
 from mcap_ros2.decoder import DecoderFactory
-from numba import njit
 
+from .compiled import compiled
 from .params import ConfigError
 
 
@@ -86,24 +86,24 @@ DECODED = ('safety_event', 'controller_gain')
 END, RECORD, FULL, CUT = 0, 1, 2, 3
 
 
-@njit(cache=True)
+@compiled
 def _u32(b, o):
     return np.int64(b[o]) | (np.int64(b[o + 1]) << 8) | (np.int64(b[o + 2]) << 16) | (np.int64(b[o + 3]) << 24)
 
 
-@njit(cache=True)
+@compiled
 def _f64(b, o, tmp):
     for i in range(8):
         tmp[i] = b[o + i]
     return tmp.view(np.float64)[0]
 
 
-@njit(cache=True)
+@compiled
 def _align(p, n):
     return (p + n - 1) // n * n
 
 
-@njit(cache=True)
+@compiled
 def _scan(b, pos, kinds, counts, js, cmd, tru, n):
     """Scan the records of a chunk from ``pos``: count every message per channel and take the
     fields of joint_states, voltage_command and plant_state (little-endian CDR) into ``js``

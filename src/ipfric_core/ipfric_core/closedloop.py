@@ -16,8 +16,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
+from .compiled import compiled
 from .controller import StateFeedback, feedback, filter_coefficient, filtered_rate
 from .rig import Rig, input_effects, play, sensor_reading
 from .simulate import advance, friction_now
@@ -112,7 +112,7 @@ def _run_compiled(rig, c, n, t, st, meas, volt, fric, stuck):
                  t, st, meas, volt, fric, stuck)
 
 
-@njit(cache=True)
+@compiled
 def _loop(pp, fp, ef, s, mode, substep, dt, resolution, sensors, drive, gain, control, limits,
           t, st, meas, volt, fric, stuck):
     """The closed loop of :func:`_run_python`, compiled. Returns (samples, END_REASONS index)."""

@@ -9,7 +9,8 @@ from __future__ import annotations
 import math
 from collections import deque
 
-from numba import njit
+from .compiled import compiled
+
 
 
 def delay_samples(tau: float, dt: float) -> int:
@@ -23,7 +24,7 @@ def delay_samples(tau: float, dt: float) -> int:
     return n
 
 
-@njit(cache=True)
+@compiled
 def filter_coefficient(cutoff_hz: float, dt: float) -> float:
     """Pole a of the first-order velocity filter v_k = a v_k-1 + (1 - a) raw_k (0 = no filter)."""
     if cutoff_hz <= 0:
@@ -31,13 +32,13 @@ def filter_coefficient(cutoff_hz: float, dt: float) -> float:
     return math.exp(-2 * math.pi * cutoff_hz * dt)
 
 
-@njit(cache=True)
+@compiled
 def filtered_rate(a: float, rate: float, last: float, value: float, dt: float) -> float:
     """Next filtered velocity from the previous one and a backward difference."""
     return a * rate + (1 - a) * ((value - last) / dt)
 
 
-@njit(cache=True)
+@compiled
 def feedback(gain, state, limit: float) -> float:
     """V = sat(K . s) [V], |V| <= ``limit``."""
     v = gain[0] * state[0] + gain[1] * state[1] + gain[2] * state[2] + gain[3] * state[3]

@@ -25,8 +25,8 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
 
+from .compiled import compiled
 from .params import FrictionParams
 
 #: Codes of the friction models in a parameter vector (floats, so the vector is uniform).
@@ -47,7 +47,7 @@ def parameter_vector(params: FrictionParams, normal_force: float) -> tuple:
             float(normal_force))
 
 
-@njit(cache=True)
+@compiled
 def stribeck_level(v: float, mu_s: float, mu_c: float, v_s: float, gamma: float,
                    normal_force: float) -> float:
     """g(v) = (mu_c + (mu_s - mu_c) exp(-(|v|/v_s)^gamma)) F_N  [N], eq. (8)."""
@@ -63,25 +63,25 @@ def static_friction(applied: float, limit: float) -> float:
     return -math.copysign(limit, applied)
 
 
-@njit(cache=True)
+@compiled
 def sticks(fp) -> bool:
     """True when the law has a sticking phase: coulomb or exponential without smoothing."""
     return (fp[MODEL] == COULOMB or fp[MODEL] == EXPONENTIAL) and fp[SMOOTH] == 0.0
 
 
-@njit(cache=True)
+@compiled
 def static_limit(fp) -> float:
     """Largest force static friction can hold, mu_s F_N [N] (eq. 5); 0 for viscous."""
     return 0.0 if fp[MODEL] == VISCOUS else fp[MU_S] * fp[FN]
 
 
-@njit(cache=True)
+@compiled
 def holds(fp, applied: float) -> bool:
     """True when static friction can hold the resting cart against ``applied`` [N] (eq. 5)."""
     return abs(applied) < static_limit(fp)
 
 
-@njit(cache=True)
+@compiled
 def sliding_level(fp, v: float) -> float:
     """Magnitude of the velocity-dependent sliding friction [N]: 0, mu_c F_N or g(v)."""
     if fp[MODEL] == VISCOUS:
@@ -91,7 +91,7 @@ def sliding_level(fp, v: float) -> float:
     return stribeck_level(v, fp[MU_S], fp[MU_C], fp[V_S], fp[GAMMA], fp[FN])
 
 
-@njit(cache=True)
+@compiled
 def friction_force(fp, v: float, z: float, direction: float) -> float:
     """Friction force on the moving cart [N], eqs. (3), (6)-(8), (11).
 
@@ -112,7 +112,7 @@ def friction_force(fp, v: float, z: float, direction: float) -> float:
     return -sliding_level(fp, v) * sign - fp[EPS] * v
 
 
-@njit(cache=True)
+@compiled
 def bristle_rate(fp, v: float, z: float) -> float:
     """Bristle deflection rate z' [m/s], eq. (10); 0 for the other laws."""
     if fp[MODEL] != DYNAMIC:

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
 
+from .compiled import compiled
 from .friction import Friction, bristle_rate, friction_force
 from .params import FrictionParams, PlantParams
 
@@ -26,13 +26,13 @@ def parameter_vector(plant: PlantParams) -> tuple:
     return tuple(float(v) for v in (plant.M, plant.m, plant.l, plant.g, plant.alpha, plant.beta))
 
 
-@njit(cache=True)
+@compiled
 def motor_force(pp, voltage: float, x_dot: float) -> float:
     """F = alpha V - beta x' [N], eq. (2)."""
     return pp[ALPHA] * voltage - pp[BETA] * x_dot
 
 
-@njit(cache=True)
+@compiled
 def accelerations(pp, theta: float, theta_dot: float, force: float):
     """(x'', theta'') from eq. (16) for a total horizontal force on the cart [N]."""
     m, l, g = pp[MP], pp[L], pp[G]
@@ -43,7 +43,7 @@ def accelerations(pp, theta: float, theta_dot: float, force: float):
     return xdd, thdd
 
 
-@njit(cache=True)
+@compiled
 def held_force(pp, theta: float, theta_dot: float, force: float) -> float:
     """Force static friction must cancel to keep the cart at rest [N] (eq. 5's F_applied).
 
@@ -56,13 +56,13 @@ def held_force(pp, theta: float, theta_dot: float, force: float) -> float:
     return force + m * l * s * theta_dot ** 2 - 0.75 * m * pp[G] * c * s
 
 
-@njit(cache=True)
+@compiled
 def stuck_theta_acceleration(pp, theta: float) -> float:
     """theta'' [rad/s^2] while the cart is held at rest: 3 g sin(theta) / (4 l)."""
     return 0.75 * pp[G] * math.sin(theta) / pp[L]
 
 
-@njit(cache=True)
+@compiled
 def undeclared_force(ef, x: float, v: float) -> float:
     """Force on the cart [N] from effects the friction model does not declare.
 
@@ -79,7 +79,7 @@ def undeclared_force(ef, x: float, v: float) -> float:
 NO_EXTRA_FORCE = (0.0, 1.0, 0.0)
 
 
-@njit(cache=True)
+@compiled
 def rates(pp, fp, ef, s, voltage: float, direction: float):
     """ds/dt of the sliding (or smooth) motion, eq. (16) with (17) and the friction law.
 

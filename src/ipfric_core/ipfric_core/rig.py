@@ -12,8 +12,8 @@ import random
 from collections import deque
 from dataclasses import asdict, dataclass
 
-from numba import njit
 
+from .compiled import compiled
 from .encoder import quantize
 from .plant import CartPendulum
 from .simulate import Simulator
@@ -55,7 +55,7 @@ class PlantTruth:
         return (float(self.cogging_N), float(self.cogging_period_m), float(self.asymmetry_N))
 
 
-@njit(cache=True)
+@compiled
 def input_effects(voltage: float, deadzone: float, saturation: float) -> float:
     """Voltage that reaches the motor after a deadzone and a saturation [V] (0 = off)."""
     v = voltage
@@ -71,7 +71,7 @@ def apply_input_effects(voltage: float, truth: PlantTruth) -> float:
     return input_effects(float(voltage), truth.deadzone_V, truth.saturation_V)
 
 
-@njit(cache=True)
+@compiled
 def play(previous: float, value: float, gap: float) -> float:
     """Backlash (play operator): the output follows ``value`` only beyond +/- gap/2."""
     half = 0.5 * gap
@@ -82,7 +82,7 @@ def play(previous: float, value: float, gap: float) -> float:
     return previous
 
 
-@njit(cache=True)
+@compiled
 def sensor_reading(x, theta, bias_x, bias_theta, noise_x, noise_theta, resolution):
     """Encoder readings (x [m], theta [rad]): offsets and noise added, then quantized."""
     return (quantize(x + bias_x + noise_x, resolution[0]),

@@ -23,8 +23,8 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
 
+from .compiled import compiled
 from .friction import friction_force, holds, static_limit, sticks
 from .plant import (NO_EXTRA_FORCE, CartPendulum, held_force, motor_force, rates,
                     stuck_theta_acceleration, undeclared_force)
@@ -33,7 +33,7 @@ MAX_EVENTS = 64  # per substep; a guard, never reached in normal motion
 XTOL = 1e-13     # event time tolerance [s]
 
 
-@njit(cache=True)
+@compiled
 def rk4_slide(pp, fp, ef, s, h, voltage, d):
     """One RK4 step of length ``h`` [s] of the sliding motion with sgn(x') = ``d``."""
     k1 = rates(pp, fp, ef, s, voltage, d)
@@ -53,7 +53,7 @@ def rk4_slide(pp, fp, ef, s, h, voltage, d):
             s[4] + c * (k1[4] + 2 * k2[4] + 2 * k3[4] + k4[4]))
 
 
-@njit(cache=True)
+@compiled
 def rk4_stuck(pp, s, h):
     """One RK4 step of the pendulum over the resting cart (x, x' frozen)."""
     th, w = s[1], s[3]
@@ -65,13 +65,13 @@ def rk4_stuck(pp, s, h):
             w + h / 6.0 * (k1w + 2 * k2w + 2 * k3w + k4w), s[4])
 
 
-@njit(cache=True)
+@compiled
 def held(pp, ef, s, voltage):
     """Force static friction must cancel to keep the cart at rest in state ``s`` [N]."""
     return held_force(pp, s[1], s[3], motor_force(pp, voltage, 0.0) + undeclared_force(ef, s[0], 0.0))
 
 
-@njit(cache=True)
+@compiled
 def _event(kind, pp, fp, ef, s, tau, voltage, d, level):
     """Event functions of the step length tau [s], each changing sign at the event.
 
@@ -85,7 +85,7 @@ def _event(kind, pp, fp, ef, s, tau, voltage, d, level):
     return rk4_slide(pp, fp, ef, s, tau, voltage, d)[2] * d
 
 
-@njit(cache=True)
+@compiled
 def _locate(kind, pp, fp, ef, s, hi, voltage, d, level):
     """Root in (0, hi) of :func:`_event` by Brent's method (as scipy's brentq), tolerance XTOL."""
     xpre, xcur = 0.0, hi
@@ -129,7 +129,7 @@ def _locate(kind, pp, fp, ef, s, hi, voltage, d, level):
     return xcur
 
 
-@njit(cache=True)
+@compiled
 def _settle(pp, fp, ef, s, voltage, events):
     """At x' = 0: stick if static friction holds, else slide along the held force."""
     applied = held(pp, ef, s, voltage)
@@ -138,7 +138,7 @@ def _settle(pp, fp, ef, s, voltage, events):
     return s, (0.0, math.copysign(1.0, applied), events + 1.0)
 
 
-@njit(cache=True)
+@compiled
 def _advance_hybrid(pp, fp, ef, s, mode, h, voltage):
     stuck, d, events = mode
     lim = static_limit(fp)
@@ -178,7 +178,7 @@ def _advance_hybrid(pp, fp, ef, s, mode, h, voltage):
     return rk4_slide(pp, fp, ef, s, remaining, voltage, d), (stuck, d, events)
 
 
-@njit(cache=True)
+@compiled
 def advance(pp, fp, ef, s, mode, voltage, dt, substep):
     """State and mode after ``dt`` [s] with ``voltage`` [V] held, in RK4 substeps <= ``substep``."""
     n = max(1, math.ceil(dt / substep - 1e-9))
@@ -192,7 +192,7 @@ def advance(pp, fp, ef, s, mode, voltage, dt, substep):
     return s, mode
 
 
-@njit(cache=True)
+@compiled
 def friction_now(pp, fp, ef, s, mode, voltage):
     """Friction force on the cart in state ``s`` and ``mode`` [N] (static while stuck)."""
     if mode[0] != 0.0:
