@@ -21,6 +21,7 @@ import math
 import sys
 
 import rclpy
+from ipfric_core.closedloop import warm_up
 from ipfric_core.controller import delay_samples
 from ipfric_core.params import ConfigError
 from ipfric_core.scenario import Scenario
@@ -59,6 +60,7 @@ class ControllerNode(Node):
         self.period_ns = round(1e9 / c.sample_rate_hz)
         self.dt = 1.0 / c.sample_rate_hz
         self.controller = self.scenario.make_controller()
+        warm_up(self.scenario)  # numba code loaded before sample 0, not during it
         how = 'from the parameter file' if c.gain_source == 'yaml' else (
             f'designed by LQR on the {c.design_friction.model} friction model, Q = {list(c.Q)}, R = {c.R:g}')
         if c.gain_source == 'design':  # let `gain` show the gain in use
@@ -122,7 +124,7 @@ class ControllerNode(Node):
             if p.name == 'delay':
                 self.controller.set_delay(value)
             elif p.name == 'gain':
-                self.controller.gain = [float(k) for k in value]
+                self.controller.gain = tuple(float(k) for k in value)
                 if self.ready:
                     self._publish_gain()
             elif p.name == 'cutoff_hz':

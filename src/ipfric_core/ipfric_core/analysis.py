@@ -27,7 +27,8 @@ def run_name(path: str | Path) -> str:
 
 def analyze_run(path: str | Path, plot_dir: str | Path | None = None, window: float = 10.0) -> dict:
     """Classify one run from its bag; write its figure to ``plot_dir`` if given."""
-    run = read_run(path)
+    run = read_run(path, keep=('joint_states',) if plot_dir is None else ('joint_states', 'voltage_command',
+                                                                         'plant_state'))
     sim = (run.config or {}).get('sim', {})
     fallen = sim.get('fallen_angle', math.radians(30.0))
     ended = run.end_reason in ('FALLEN', 'TRACK_LIMIT')

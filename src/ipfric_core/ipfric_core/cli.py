@@ -404,6 +404,18 @@ def cmd_identify(args) -> int:
           f'report {Path(args.out) / "report.md"}')
     if args.export:
         print(f'  exported {r["export"]["scenario"]}' + (f' and {r["export"]["on_rig"]}' if args.rig else ''))
+def cmd_bench(args) -> int:
+    sys.path.insert(0, str(REPO_ROOT))
+    from bench.run import run_all
+    results = Path(args.results) if args.results else (
+        REPO_ROOT / 'runs' / 'bench-quick' / 'RESULTS.md' if args.quick else REPO_ROOT / 'bench' / 'RESULTS.md')
+    out = run_all(args.quick, args.realtime_duration, results,
+                  progress=(lambda msg: print(msg, file=sys.stderr)))
+    if args.json:
+        _print_json(out)
+        return 0
+    print(out['table'])
+    print(f'written: {out["results"]}')
     return 0
 
 
@@ -500,6 +512,13 @@ def build_parser() -> argparse.ArgumentParser:
                    'its measured data, redesign, run again; prints the amplitudes before and after')
     i.add_argument('--duration', type=float, default=20.0, help='--loop: simulated seconds per run '
                    '(default %(default)s)')
+    b = add('bench', cmd_bench, 'benchmarks beside their references (scipy, MuJoCo, raw rclpy): offline closed '
+            'loop, Figure-11 sweep, ROS lockstep and realtime loops, analyze, identify; table and bench/RESULTS.md')
+    b.add_argument('--quick', action='store_true', help='tiny sizes: check that every benchmark runs (no targets)')
+    b.add_argument('--realtime-duration', type=float, default=600.0,
+                   help='seconds of the realtime ROS run whose bag analyze reads (default %(default)s)')
+    b.add_argument('--results', default=None, help='where to write the table (default bench/RESULTS.md, '
+                   'runs/bench-quick/RESULTS.md with --quick)')
     return p
 
 

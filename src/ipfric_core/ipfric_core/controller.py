@@ -9,6 +9,9 @@ from __future__ import annotations
 import math
 from collections import deque
 
+from .compiled import compiled
+
+
 
 def delay_samples(tau: float, dt: float) -> int:
     """Number of samples n with tau = n dt; raises ValueError if tau is not a multiple."""
@@ -19,6 +22,27 @@ def delay_samples(tau: float, dt: float) -> int:
         raise ValueError(f'delay tau = {tau:g} s is not a multiple of the sample period '
                          f'{dt:g} s; allowed: n * {dt:g} s, e.g. {n * dt:g} s')
     return n
+
+
+@compiled
+def filter_coefficient(cutoff_hz: float, dt: float) -> float:
+    """Pole a of the first-order velocity filter v_k = a v_k-1 + (1 - a) raw_k (0 = no filter)."""
+    if cutoff_hz <= 0:
+        return 0.0
+    return math.exp(-2 * math.pi * cutoff_hz * dt)
+
+
+@compiled
+def filtered_rate(a: float, rate: float, last: float, value: float, dt: float) -> float:
+    """Next filtered velocity from the previous one and a backward difference."""
+    return a * rate + (1 - a) * ((value - last) / dt)
+
+
+@compiled
+def feedback(gain, state, limit: float) -> float:
+    """V = sat(K . s) [V], |V| <= ``limit``."""
+    v = gain[0] * state[0] + gain[1] * state[1] + gain[2] * state[2] + gain[3] * state[3]
+    return max(-limit, min(limit, v))
 
 
 class StateFeedback:
@@ -45,7 +69,7 @@ class StateFeedback:
             raise ValueError(f'gain: expected 4 finite numbers (x, theta, x\', theta\'), got {gain}')
         if not dt > 0:
             raise ValueError(f'dt = {dt!r}: must be > 0')
-        self.gain = gain[:4]
+        self.gain = tuple(gain[:4])
         self.dt = dt
         self.cutoff_hz = float(cutoff_hz)
         self.voltage_limit = float(voltage_limit)
@@ -63,19 +87,14 @@ class StateFeedback:
             while len(self._history) < n + 1:
                 self._history.appendleft(self._history[0])
 
-    def _filter_coefficient(self) -> float:
-        if self.cutoff_hz <= 0:
-            return 0.0
-        return math.exp(-2 * math.pi * self.cutoff_hz * self.dt)
-
     def estimate(self, x: float, theta: float) -> tuple[float, float, float, float]:
         """Push one measurement; return the current state estimate."""
         if self._last is None:
             self._last = (x, theta)
             return (x, theta, 0.0, 0.0)
-        a = self._filter_coefficient()
-        raw = ((x - self._last[0]) / self.dt, (theta - self._last[1]) / self.dt)
-        self._vel = [a * v + (1 - a) * r for v, r in zip(self._vel, raw)]
+        a = filter_coefficient(self.cutoff_hz, self.dt)
+        self._vel = [filtered_rate(a, self._vel[0], self._last[0], x, self.dt),
+                     filtered_rate(a, self._vel[1], self._last[1], theta, self.dt)]
         self._last = (x, theta)
         return (x, theta, self._vel[0], self._vel[1])
 
@@ -86,6 +105,4 @@ class StateFeedback:
             self._history.extend([est] * self._history.maxlen)
         else:
             self._history.append(est)
-        used = self._history[0]
-        v = sum(k * s for k, s in zip(self.gain, used))
-        return max(-self.voltage_limit, min(self.voltage_limit, v))
+        return feedback(self.gain, self._history[0], self.voltage_limit)

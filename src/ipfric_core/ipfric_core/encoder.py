@@ -6,12 +6,17 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
+from .compiled import compiled
+
 ANGLE_RESOLUTION_RAD = math.radians(0.08789)
 CART_RESOLUTION_M = 0.00454e-2
 
 
+@compiled
 def quantize(value: float, resolution: float) -> float:
-    """``value`` rounded to the nearest multiple of ``resolution`` (0 disables)."""
+    """``value`` rounded to the nearest multiple of ``resolution`` (0 disables; halves to even)."""
     if resolution <= 0.0:
         return value
-    return resolution * round(value / resolution)
+    return resolution * np.round(value / resolution)

@@ -12,6 +12,8 @@ import random
 from collections import deque
 from dataclasses import asdict, dataclass
 
+
+from .compiled import compiled
 from .encoder import quantize
 from .plant import CartPendulum
 from .simulate import Simulator
@@ -48,18 +50,28 @@ class PlantTruth:
     def to_dict(self) -> dict:
         return asdict(self)
 
+    def force_vector(self) -> tuple:
+        """The forces on the cart as ``plant.undeclared_force`` takes them."""
+        return (float(self.cogging_N), float(self.cogging_period_m), float(self.asymmetry_N))
 
-def apply_input_effects(voltage: float, truth: PlantTruth) -> float:
-    """Voltage that reaches the motor after deadzone and saturation [V]."""
+
+@compiled
+def input_effects(voltage: float, deadzone: float, saturation: float) -> float:
+    """Voltage that reaches the motor after a deadzone and a saturation [V] (0 = off)."""
     v = voltage
-    dz = truth.deadzone_V
-    if dz > 0.0:
-        v = 0.0 if abs(v) <= dz else v - math.copysign(dz, v)
-    if truth.saturation_V > 0.0:
-        v = max(-truth.saturation_V, min(truth.saturation_V, v))
+    if deadzone > 0.0:
+        v = 0.0 if abs(v) <= deadzone else v - math.copysign(deadzone, v)
+    if saturation > 0.0:
+        v = max(-saturation, min(saturation, v))
     return v
 
 
+def apply_input_effects(voltage: float, truth: PlantTruth) -> float:
+    """Voltage that reaches the motor after the rig's deadzone and saturation [V]."""
+    return input_effects(float(voltage), truth.deadzone_V, truth.saturation_V)
+
+
+@compiled
 def play(previous: float, value: float, gap: float) -> float:
     """Backlash (play operator): the output follows ``value`` only beyond +/- gap/2."""
     half = 0.5 * gap
@@ -68,6 +80,13 @@ def play(previous: float, value: float, gap: float) -> float:
     if value < previous - half:
         return value + half
     return previous
+
+
+@compiled
+def sensor_reading(x, theta, bias_x, bias_theta, noise_x, noise_theta, resolution):
+    """Encoder readings (x [m], theta [rad]): offsets and noise added, then quantized."""
+    return (quantize(x + bias_x + noise_x, resolution[0]),
+            quantize(theta + bias_theta + noise_theta, resolution[1]))
 
 
 class Rig:
@@ -92,23 +111,13 @@ class Rig:
         self.resolution = resolution
         self.track_limit = track_limit
         self.fallen_angle = fallen_angle
-        self.sim = Simulator(model, state0, extra_force=self._extra_force if self._has_force() else None)
+        self.sim = Simulator(model, state0, extra_force=truth.force_vector())
         n = round(truth.input_delay_s / dt)
         self._pending = deque([0.0] * n)
         self._rng = random.Random(truth.noise_seed)
         self._backlash_x = self.sim.state[0]
         self.k = 0
         self.voltage_applied = 0.0
-
-    def _has_force(self) -> bool:
-        return self.effects.cogging_N != 0.0 or self.effects.asymmetry_N != 0.0
-
-    def _extra_force(self, x: float, v: float) -> float:
-        t = self.effects
-        f = t.cogging_N * math.sin(2 * math.pi * x / t.cogging_period_m)
-        if v != 0.0:
-            f -= t.asymmetry_N
-        return f
 
     @property
     def t(self) -> float:
@@ -122,13 +131,9 @@ class Rig:
             x = self._backlash_x
         else:
             x = s[0]
-        x += t.bias_x_m
-        th = s[1] + t.bias_theta_rad
-        if t.noise_x_m:
-            x += self._rng.gauss(0.0, t.noise_x_m)
-        if t.noise_theta_rad:
-            th += self._rng.gauss(0.0, t.noise_theta_rad)
-        return quantize(x, self.resolution[0]), quantize(th, self.resolution[1])
+        nx = self._rng.gauss(0.0, t.noise_x_m) if t.noise_x_m else 0.0
+        nth = self._rng.gauss(0.0, t.noise_theta_rad) if t.noise_theta_rad else 0.0
+        return sensor_reading(x, s[1], t.bias_x_m, t.bias_theta_rad, nx, nth, self.resolution)
 
     def step(self, voltage: float) -> None:
         """Hold ``voltage`` [V] (as commanded) for one sample period."""

@@ -27,10 +27,14 @@ import json
 import sys
 import threading
 import time
+from array import array
 from collections import Counter
+
+import numpy as np
 
 import rclpy
 from builtin_interfaces.msg import Time
+from ipfric_core.closedloop import warm_up
 from ipfric_core.params import ConfigError
 from ipfric_msgs.msg import PlantState, SafetyEvent, VoltageCommand
 from rclpy.duration import Duration
@@ -80,6 +84,7 @@ class SimNode(Node):
         s = self.scenario.sim
         self.settings = s
         self.rig = self.scenario.make_rig()
+        warm_up(self.scenario)  # numba code loaded before sample 0, not during it
         self.period_ns = round(1e9 / s.sample_rate_hz)
         self.last_sample = round(s.duration * s.sample_rate_hz) if s.duration > 0 else None
         self.guard = CommandGuard(s.voltage_max, s.watchdog_samples)
@@ -97,6 +102,8 @@ class SimNode(Node):
         self.published = Counter()
         self.gain = None
         self.stale = 0
+        self._sent_at = array('d')  # [s] monotonic time measurement k was published, at index k
+        self.latency = array('d')   # [s] from publishing a measurement to taking its command
         self._waiting_for = -1      # lockstep: sample whose command is awaited
         self._command = None        # lockstep: its voltage; realtime: latest unused voltage
         self._executor = SingleThreadedExecutor()
@@ -110,14 +117,15 @@ class SimNode(Node):
 
     # -- subscriptions ---------------------------------------------------------------------
     def _on_command(self, msg: VoltageCommand) -> None:
-        if not self.lockstep:
-            self._command = msg.voltage
-        elif msg.sample_index == self._waiting_for:
+        if not self.lockstep or msg.sample_index == self._waiting_for:
             self._command = msg.voltage
         else:
             self.stale += 1
             self.get_logger().warning(f'command for sample {msg.sample_index} ignored while waiting for '
                                       f'sample {self._waiting_for}', throttle_duration_sec=1.0)
+            return
+        if msg.sample_index < len(self._sent_at):
+            self.latency.append(time.monotonic() - self._sent_at[msg.sample_index])
 
     def _on_gain(self, msg: Float64MultiArray) -> None:
         self.gain = list(msg.data)
@@ -137,6 +145,7 @@ class SimNode(Node):
         js = JointState(name=list(topics.JOINT_NAMES), position=[x, theta])
         js.header.stamp = stamp
         self.pub_joints.publish(js)
+        self._sent_at.append(time.monotonic())
         ps = PlantState(x=tr['x'], theta=tr['theta'], x_dot=tr['x_dot'], theta_dot=tr['theta_dot'],
                         friction_force=tr['friction_force'], z=tr['z'], stuck=bool(tr['stuck']),
                         voltage_applied=tr['voltage_applied'], sample_index=k)
@@ -304,6 +313,7 @@ class SimNode(Node):
             'steps_per_s': samples / wall if wall > 0 else None, 'published': dict(self.published),
             'commands_refused': self.guard.refused, 'samples_without_command': self.guard.missing,
             'stale_commands': self.stale, 'watchdog_tripped': self.guard.tripped,
+            'command_latency_s': self._latency_summary(),
             'time_mode': self.settings.time_mode, 'gain': self.gain,
         }
         self.get_logger().info(f'run ended: {code} ({detail}); {samples} samples in {wall:.2f} s wall '
@@ -312,6 +322,14 @@ class SimNode(Node):
             with open(self.result_file, 'w') as f:
                 json.dump(result, f, indent=2)
         return 0
+
+    def _latency_summary(self) -> dict:
+        """Wall time from publishing a measurement to taking its command [s]: median, p99, max."""
+        lat = np.frombuffer(self.latency, dtype=float)
+        if not len(lat):
+            return {'commands': 0}
+        return {'commands': int(len(lat)), 'median': float(np.median(lat)),
+                'p99': float(np.percentile(lat, 99)), 'max': float(lat.max())}
 
     def _flush(self, timeout: float = 5.0) -> None:
         """Wait until every subscriber acknowledged what was published (reliable QoS).

@@ -1,0 +1,1 @@
+"""Benchmarks of ipfric against references run side by side (``./ipfric bench``)."""

@@ -1,0 +1,296 @@
+"""``./ipfric bench``: every benchmark of ipfric beside its reference, run side by side.
+
+Timings on a shared machine are noisy, so each target is a ratio to a reference measured
+in the same run; absolute times are context. ``quick`` shrinks every benchmark to check
+that it still runs (its numbers are not compared with the targets).
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import platform
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from ipfric_core.closedloop import run_closed_loop
+from ipfric_core.oscillation import classify, crossing_period
+from ipfric_core.paperconfig import REPO_ROOT
+from ipfric_core.scenario import load_scenario
+from ipfric_core.sweep import cell_scenario, parse_range, sweep
+
+CONFIG = REPO_ROOT / 'config'
+EMPS = REPO_ROOT.parent / 'shared' / 'data' / 'emps'
+ACCURACY = 0.005          # limit-cycle amplitude and period within 0.5 % of scipy
+MUJOCO_STEPS = (1e-3, 5e-4, 2.5e-4)
+
+
+def exact(s):
+    """Scenario with exact sensors (no encoder quantization)."""
+    return replace(s, sim=replace(s.sim, cart_resolution=0.0, angle_resolution=0.0))
+
+
+def timed(fn, repeat: int = 1):
+    """(median wall time [s], last result) of ``repeat`` calls."""
+    times, out = [], None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times), out
+
+
+def cycle(tr, settle: float) -> tuple[float, float | None]:
+    """Limit cycle of a run: cart peak-to-peak [m] and period [s] after ``settle`` [s]."""
+    late = tr.t >= settle
+    return float(np.ptp(tr.state[late, 0])), crossing_period(tr.t[late], tr.state[late, 0])
+
+
+def rel_error(a, b) -> float:
+    """Largest relative difference of (amplitude, period) pairs; inf when a period is missing."""
+    if a[1] is None or b[1] is None:
+        return math.inf
+    return max(abs(a[0] / b[0] - 1), abs(a[1] / b[1] - 1))
+
+
+def machine() -> dict:
+    cpu = 'unknown'
+    try:
+        cpu = next(line.split(':', 1)[1].strip() for line in open('/proc/cpuinfo') if line.startswith('model name'))
+    except (OSError, StopIteration):
+        pass
+    mem = ''
+    try:
+        mem = next(line.split(':', 1)[1].strip() for line in open('/proc/meminfo') if line.startswith('MemTotal'))
+    except (OSError, StopIteration):
+        pass
+    import mujoco
+    import numba
+    import scipy
+    return {'cpu': cpu, 'cores': os.cpu_count(), 'memory': mem, 'kernel': platform.release(),
+            'python': platform.python_version(), 'numpy': np.__version__, 'scipy': scipy.__version__,
+            'numba': numba.__version__, 'mujoco': mujoco.__version__,
+            'load_average_at_start': os.getloadavg(), 'date_utc': time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}
+
+
+# ------------------------------------------------------------------------ offline closed loop
+def bench_closed_loop(quick: bool) -> list[dict]:
+    from .mujoco_reference import MujocoLoop
+    from .scipy_reference import run_scipy
+    base = load_scenario(CONFIG / 'fig7_old_gain_exponential.yaml')
+    duration = 2.0 if quick else 20.0
+    run_closed_loop(base.make_rig(), base.make_controller(), 0.01)  # compile / load the cache
+    t_ipf, _ = timed(lambda: run_closed_loop(base.make_rig(), base.make_controller(), duration), 1 if quick else 7)
+    t_sci, _ = timed(lambda: run_scipy(base, duration))
+    # accuracy: exact sensors, where the limit cycle is a well-conditioned number (with the
+    # encoders it moves by a few % between converged integrators); 30 s for several periods
+    ex, span = exact(base), 2.0 if quick else 30.0
+    settle = span / 3
+    ref = cycle(run_scipy(ex, span), settle)
+    ours = cycle(run_closed_loop(ex.make_rig(), ex.make_controller(), span), settle)
+    err_ipf = rel_error(ours, ref)
+    mj = []
+    for h in MUJOCO_STEPS:
+        loop = MujocoLoop(ex, h)
+        mj.append((h, rel_error(cycle(loop.run(span), settle), ref)))
+    good = [h for h, e in mj if e <= ACCURACY]
+    h_mj = max(good) if good else min(MUJOCO_STEPS)
+    err_mj = dict(mj)[h_mj]
+    loop = MujocoLoop(base, h_mj)
+    loop.run(0.01)
+    t_mj, _ = timed(lambda: loop.run(duration), 1 if quick else 5)
+    sweep_note = ', '.join(f'h {h * 1e3:g} ms: {100 * e:.3g} %' for h, e in mj)
+    return [
+        {'benchmark': f'closed loop {duration:g} s, Fig. 7 stick-slip, 1 kHz, encoders',
+         'reference': f'scipy LSODA + events {t_sci:.3g} s', 'ipfric': f'{t_ipf * 1e3:.3g} ms',
+         'ratio': t_sci / t_ipf, 'target': '>= 50x faster', 'met': t_sci / t_ipf >= 50},
+        {'benchmark': f'closed loop {duration:g} s vs MuJoCo (fastest accurate: Euler h {h_mj * 1e3:g} ms)',
+         'reference': f'MuJoCo {t_mj * 1e3:.3g} ms', 'ipfric': f'{t_ipf * 1e3:.3g} ms',
+         'ratio': t_mj / t_ipf, 'target': 'faster than MuJoCo', 'met': t_mj / t_ipf > 1},
+        {'benchmark': 'limit cycle error vs scipy (amplitude, period; exact sensors)',
+         'reference': f'MuJoCo {100 * err_mj:.3g} % ({sweep_note})', 'ipfric': f'{100 * err_ipf:.2g} %',
+         'ratio': None, 'target': '<= 0.5 %', 'met': err_ipf <= ACCURACY and good != []},
+    ]
+
+
+# ------------------------------------------------------------------------------------ sweep
+_MJ = {}
+
+
+def _mujoco_cell(args):
+    from .mujoco_reference import MujocoLoop
+    base, tau, th, duration = args
+    if 'loop' not in _MJ:
+        _MJ['loop'] = MujocoLoop(base, 1e-3)
+    tr = _MJ['loop'].run(duration, theta0=math.radians(th), delay=tau)
+    scn = cell_scenario(base, tau, th)
+    return classify(tr.t, tr.measured[:, 0], tr.measured[:, 1], (0.0, 0.0), scn.sim.fallen_angle,
+                    ended_fallen=tr.end_reason != 'duration').cls
+
+
+def bench_sweep(quick: bool) -> list[dict]:
+    base = exact(load_scenario(CONFIG / 'fig9_new_gain_exponential.yaml'))
+    taus = parse_range('0:0.01:0.005' if quick else '0:0.14:0.005')
+    ths = parse_range('0:1:0.5' if quick else '0:12:0.5')
+    duration = 2.0 if quick else 20.0
+    with tempfile.TemporaryDirectory() as tmp:
+        t_ipf, rows = timed(lambda: sweep(base, taus, ths, duration, tmp, workers=2))
+    cells = [(base, float(t), float(th), duration) for th in ths for t in taus]
+    with ProcessPoolExecutor(max_workers=2) as pool:
+        t_mj, classes = timed(lambda: list(pool.map(_mujoco_cell, cells, chunksize=max(1, len(cells) // 8))))
+    agree = np.mean([r['class'] == c for r, c in zip(rows, classes)])
+    ok = t_ipf < 10.0 and t_ipf < t_mj
+    return [{'benchmark': f'Figure-11 sweep, {len(cells)} runs of {duration:g} s, 2 processes',
+             'reference': f'MuJoCo {t_mj:.3g} s (same class in {100 * agree:.0f} % of cells)',
+             'ipfric': f'{t_ipf:.3g} s', 'ratio': t_mj / t_ipf, 'target': '< 10 s and faster than MuJoCo',
+             'met': ok}]
+
+
+# -------------------------------------------------------------------------------------- ROS
+def _echo_rate(n: int) -> float:
+    from ipfric_core.runner import pick_domain, ros_environment
+    env = ros_environment(pick_domain())
+    script = str(Path(__file__).with_name('ros_echo.py'))
+    echo = subprocess.Popen([sys.executable, script, 'echo'], env=env, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    try:
+        out = subprocess.run([sys.executable, script, 'ping', str(n)], env=env, capture_output=True, text=True,
+                             timeout=120, check=True)
+        return json.loads(out.stdout.strip().splitlines()[-1])['per_s']
+    finally:
+        echo.send_signal(2)
+        try:
+            echo.wait(10)
+        except subprocess.TimeoutExpired:
+            echo.kill()
+
+
+def bench_ros(quick: bool, realtime_s: float, work: Path) -> tuple[list[dict], Path]:
+    from ipfric_core.runner import run
+    cfg = CONFIG / 'default.yaml'
+    lock = run(cfg, work / 'lockstep', 1.0 if quick else 20.0)
+    echo = _echo_rate(500 if quick else 5000)
+    steps = lock.steps_per_s or 0.0
+    rows = [{'benchmark': f'ROS lockstep loop, sim + controller + recorder ({lock.samples} samples)',
+             'reference': f'raw rclpy round trip {echo:.0f}/s', 'ipfric': f'{steps:.0f} steps/s',
+             'ratio': steps / echo, 'target': '>= 1000/s and >= 0.8x raw', 'met': steps >= 1000 and steps >= 0.8 * echo}]
+    rt = run(cfg, work / 'realtime', realtime_s, sim_params={'time_mode': 'realtime'})
+    res = json.loads((work / 'realtime' / 'sim_result.json').read_text())
+    lat = res['command_latency_s']
+    late = res['samples_without_command']   # the command of the previous sample was not there in time
+    text = (f'{lat["median"] * 1e3:.3g} / {lat["p99"] * 1e3:.3g} ({lat["max"] * 1e3:.3g}) ms; {late} samples '
+            f'without a fresh command' if lat['commands'] else 'no commands')
+    rows.append({'benchmark': f'ROS realtime 1 kHz, {realtime_s:g} s: command latency median / p99 (max)',
+                 'reference': f'{res["samples"]} samples, {lat["commands"]} commands, bag complete: '
+                              f'{"yes" if rt.counts_match else "NO"}', 'ipfric': text,
+                 'ratio': None, 'target': 'no lost sample', 'met': late == 0 and rt.exit_code == 0})
+    return rows, Path(rt.bag)
+
+
+def _analyze(bag: Path) -> tuple[float, float, int]:
+    """(wall [s], peak RSS [MB], samples) of ./ipfric analyze --no-plots in a process of its own."""
+    cmd = [sys.executable, '-m', 'ipfric_core.cli', 'analyze', str(bag), '--no-plots', '--json']
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    out = proc.stdout.read()
+    _, status, usage = os.wait4(proc.pid, 0)
+    wall = time.perf_counter() - t0
+    if status != 0:
+        raise RuntimeError(f'analyze {bag} failed (status {status})')
+    return wall, usage.ru_maxrss / 1024, json.loads(out)['runs'][0]['samples']
+
+
+def bench_analyze(bag: Path, small: Path, minutes: float) -> list[dict]:
+    """./ipfric analyze on the realtime run's bag, beside the same on the short lockstep bag."""
+    t_small, rss_small, n_small = _analyze(small)
+    wall, rss, samples = _analyze(bag)
+    size = sum(f.stat().st_size for f in Path(bag).glob('*.mcap')) / 1e6
+    return [{'benchmark': f'analyze a {minutes:.3g}-min 1 kHz bag ({size:.0f} MB, {samples} samples)',
+             'reference': f'{n_small}-sample bag: {t_small:.3g} s, peak RSS {rss_small:.0f} MB',
+             'ipfric': f'{wall:.3g} s, peak RSS {rss:.0f} MB', 'ratio': None,
+             'target': '< 5 s, bounded memory', 'met': wall < 5.0 and rss - rss_small < size}]
+
+
+def bench_identify(quick: bool) -> list[dict]:
+    """./ipfric identify on the EMPS files, if this tree has that command."""
+    base = [sys.executable, '-m', 'ipfric_core.cli', 'identify']
+    helped = subprocess.run(base + ['--help'], capture_output=True, text=True)
+    row = {'benchmark': 'identify on EMPS (both files, full effect search)', 'reference': '-',
+           'ratio': None, 'target': '< 60 s'}
+    if helped.returncode != 0:
+        return [{**row, 'ipfric': 'not available (no identify command)', 'met': None}]
+    if quick:
+        return [{**row, 'ipfric': 'available (not run in quick mode)', 'met': None}]
+    files = sorted(str(p) for p in EMPS.glob('*.mat'))
+    args = ['--data', str(EMPS)] if '--data' in helped.stdout else files
+    t0 = time.perf_counter()
+    out = subprocess.run(base + args + ['--json'], capture_output=True, text=True, timeout=1800)
+    wall = time.perf_counter() - t0
+    if out.returncode != 0:
+        tail = (out.stderr.strip().splitlines() or ['?'])[-1]
+        return [{**row, 'ipfric': f'failed after {wall:.3g} s: {tail}', 'met': False}]
+    return [{**row, 'ipfric': f'{wall:.3g} s', 'met': wall < 60.0}]
+
+
+# ------------------------------------------------------------------------------------ table
+COLUMNS = ('benchmark', 'reference', 'ipfric', 'ratio', 'target', 'met')
+
+
+def cell(row, key, quick) -> str:
+    v = row.get(key)
+    if key == 'ratio':
+        return '-' if v is None else f'{v:.3g}x'
+    if key == 'met':
+        if v is None:
+            return 'n/a'
+        return 'ran' if quick else ('met' if v else 'missed')
+    return str(v)
+
+
+def table(rows, quick) -> str:
+    lines = ['| ' + ' | '.join(COLUMNS) + ' |', '|' + '---|' * len(COLUMNS)]
+    lines += ['| ' + ' | '.join(cell(r, k, quick) for k in COLUMNS) + ' |' for r in rows]
+    return '\n'.join(lines)
+
+
+def run_all(quick: bool = False, realtime_s: float = 600.0, results: Path | None = None,
+            progress=print) -> dict:
+    """Run every benchmark; write the table with the machine's description to ``results``."""
+    info = machine()
+    rows = []
+    work = REPO_ROOT / 'runs' / ('bench-quick' if quick else 'bench') / 'work'  # the ROS runs, kept
+    shutil.rmtree(work, ignore_errors=True)
+    for name, fn in (('closed loop', lambda: bench_closed_loop(quick)), ('sweep', lambda: bench_sweep(quick))):
+        progress(f'[bench] {name} ...')
+        rows += fn()
+    progress('[bench] ROS lockstep, rclpy round trip, realtime ...')
+    ros_rows, bag = bench_ros(quick, 2.0 if quick else realtime_s, work)
+    rows += ros_rows
+    progress('[bench] analyze ...')
+    rows += bench_analyze(bag, work / 'lockstep' / 'bag', (2.0 if quick else realtime_s) / 60)
+    progress('[bench] identify ...')
+    rows += bench_identify(quick)
+    info['load_average_at_end'] = os.getloadavg()
+    text = table(rows, quick)
+    if results is not None:
+        results.parent.mkdir(parents=True, exist_ok=True)
+        results.write_text(
+            f'# ipfric benchmarks{" (quick: checks that they run, no targets)" if quick else ""}\n\n'
+            f'`./ipfric bench{" --quick" if quick else ""}`, {info["date_utc"]}. Ratios are measured side by side '
+            f'in the same run; the machine is shared, so absolute times are context only.\n\n'
+            f'Machine: {info["cpu"]}, {info["cores"]} cores, {info["memory"]}, Linux {info["kernel"]}; '
+            f'Python {info["python"]}, numpy {info["numpy"]}, scipy {info["scipy"]}, numba {info["numba"]}, '
+            f'mujoco {info["mujoco"]}; load average {info["load_average_at_start"][0]:.2f} at start, '
+            f'{info["load_average_at_end"][0]:.2f} at end. What each row measures and where the time '
+            f'goes: docs/performance.md.\n\n{text}\n')
+    return {'quick': quick, 'machine': info, 'rows': rows, 'table': text,
+            'results': str(results) if results else None}
