@@ -404,6 +404,9 @@ def cmd_identify(args) -> int:
           f'report {Path(args.out) / "report.md"}')
     if args.export:
         print(f'  exported {r["export"]["scenario"]}' + (f' and {r["export"]["on_rig"]}' if args.rig else ''))
+    return 0
+
+
 def cmd_bench(args) -> int:
     sys.path.insert(0, str(REPO_ROOT))
     from bench.run import run_all

@@ -41,6 +41,8 @@ class Trajectory:
 
 def compiled_unsupported(rig: Rig, controller: StateFeedback) -> str | None:
     """Why the compiled engine cannot run this rig and controller, or None if it can."""
+    if type(controller) is not StateFeedback:
+        return f'the controller is a {type(controller).__name__}, not a StateFeedback'
     if rig.k != 0:
         return 'the rig has already been stepped'
     if controller._last is not None:
