@@ -58,3 +58,36 @@ def test_scenario_writes_back_as_the_same_params_file(name, tmp_path):
     back = load_scenario(path)
     assert back == scn
     assert back.controller.delay == 0.015 and back.sim.theta0 == pytest.approx(np.radians(2.5))
+
+
+def test_figure_12_sweep_reproduces_section_5(tmp_path):
+    """`./ipfric sweep --figure 12`: effective critical delay near 0.022-0.028 s for 1 < theta0 < 5 deg,
+    rising to the linear tau_c (0.107 s) as theta0 -> 0; both panels drawn from one command."""
+    import json
+    from ipfric_core.cli import main
+    out = tmp_path / 'fig12'
+    assert main(['sweep', '--figure', '12', '--tau', '0.015,0.02,0.025,0.03,0.1,0.105,0.11', '--json',
+                 '--out', str(out)]) == 0
+    s = json.loads((out / 'summary.json').read_text())
+    full = {b['theta0_deg']: b for b in s['variants']['dynamic']['full']['boundaries']}
+    zoom = {b['theta0_deg']: b for b in s['variants']['dynamic']['zoom']['boundaries']}
+    for th in (2.5, 3.0, 4.0, 4.5):
+        assert full[th]['first_unsettled_tau_s'] == 0.02 and full[th]['first_fallen_tau_s'] == 0.03
+    assert zoom[0.025]['last_settled_tau_s'] == 0.105 and zoom[0.025]['first_fallen_tau_s'] == 0.11
+    assert (out / 'figure12.png').stat().st_size > 20_000
+
+
+def test_figure_11_tanh_transitions_coalesce_for_small_angles(tmp_path):
+    """Section 5: with tanh(100 v) the two transition delays coalesce for small theta0 and approach
+    tau_c = 0.1069 s; with sgn the cart oscillates before the pendulum falls."""
+    import json
+    from ipfric_core.cli import main
+    out = tmp_path / 'fig11'
+    assert main(['sweep', '--figure', '11', '--tau', '0.01,0.02,0.03,0.04,0.05,0.1,0.105,0.11', '--json',
+                 '--out', str(out)]) == 0
+    s = json.loads((out / 'summary.json').read_text())
+    tanh = {b['theta0_deg']: b for b in s['variants']['tanh(100v)']['zoom']['boundaries']}
+    sgn = {b['theta0_deg']: b for b in s['variants']['sgn']['zoom']['boundaries']}
+    assert tanh[0.05]['last_settled_tau_s'] == 0.1 and tanh[0.05]['first_fallen_tau_s'] == 0.105
+    assert tanh[0.025]['first_unsettled_tau_s'] == tanh[0.025]['first_fallen_tau_s'] == 0.11
+    assert sgn[0.1]['first_unsettled_tau_s'] == 0.04 and sgn[0.1]['first_fallen_tau_s'] == 0.1

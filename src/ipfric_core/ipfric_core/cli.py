@@ -175,7 +175,7 @@ FIGURES = {
     '12': ('fig10_new_gain_dynamic.yaml', [('dynamic', None, '-')]),
 }
 # theta0 = 0 is left out: with exact sensors the run stays at the equilibrium for any delay
-FIGURE_GRIDS = (('full', '1:12:1'), ('zoom', '0.05:0.5:0.05'))
+FIGURE_GRIDS = (('full', '0.5:12:0.5'), ('zoom', '0.025:0.5:0.025'))
 
 
 def _figure_sweep(args, taus, progress) -> dict:
