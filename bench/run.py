@@ -230,8 +230,8 @@ def bench_identify(quick: bool) -> list[dict]:
         return [{**row, 'ipfric': 'not available (no identify command)', 'met': None}]
     if quick:
         return [{**row, 'ipfric': 'available (not run in quick mode)', 'met': None}]
-    files = sorted(str(p) for p in EMPS.glob('*.mat'))
-    args = ['--data', str(EMPS)] if '--data' in helped.stdout else files
+    args = [str(EMPS / 'DATA_EMPS.mat'), '--validation', str(EMPS / 'DATA_EMPS_PULSES.mat'), '--base', 'coulomb',
+            '--out', str(REPO_ROOT / 'runs' / 'bench-identify')]
     t0 = time.perf_counter()
     out = subprocess.run(base + args + ['--json'], capture_output=True, text=True, timeout=1800)
     wall = time.perf_counter() - t0
