@@ -32,12 +32,12 @@ from rclpy.duration import Duration
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.signals import SignalHandlerOptions
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 
 from ipfric_ros import topics
 from ipfric_ros.parameters import check_unknown, declare, declare_scenario, finite, plain
+from ipfric_ros.signals import node_process
 
 #: Parameters that may change while the controller runs.
 RUNTIME_PARAMETERS = ('delay', 'gain', 'cutoff_hz', 'voltage_limit')
@@ -174,28 +174,20 @@ class ControllerNode(Node):
 
 
 def main(args=None) -> int:
-    from ipfric_ros.signals import StopRequest
-    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
-    stop = StopRequest().install()
-    logger = rclpy.logging.get_logger('controller_node')
-    node = None
-    try:
-        node = ControllerNode()
+    with node_process('controller_node', args) as proc:
+        try:
+            node = proc.add(ControllerNode())
+        except ConfigError as exc:
+            proc.logger.fatal(f'configuration error: {exc}')
+            return 2
         executor = SingleThreadedExecutor()
         executor.add_node(node)
-        while not stop:
+        while not proc.stop:
             executor.spin_once(timeout_sec=0.1)
         node.flush()
-        logger.info(f'stopped by {stop.reason}: published {node.published} commands (last sample '
-                    f'{node.last_index}), rejected {node.rejected} measurements')
+        proc.logger.info(f'stopped by {proc.stop.reason}: published {node.published} commands (last sample '
+                         f'{node.last_index}), rejected {node.rejected} measurements')
         return 0
-    except ConfigError as exc:
-        logger.fatal(f'configuration error: {exc}')
-        return 2
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
 
 
 if __name__ == '__main__':

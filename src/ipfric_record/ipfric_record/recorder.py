@@ -33,12 +33,11 @@ from ipfric_core.scenario import load_scenario
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
-from rclpy.signals import SignalHandlerOptions
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from ipfric_ros import topics
 from ipfric_ros.parameters import check_unknown, declare
-from ipfric_ros.signals import StopRequest
+from ipfric_ros.signals import node_process
 
 from .bagwriter import BagWriter, qos_dict
 
@@ -142,25 +141,17 @@ class Recorder(Node):
 
 
 def main(args=None) -> int:
-    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
-    stop = StopRequest().install()
-    logger = rclpy.logging.get_logger('recorder')
-    node = None
-    try:
+    with node_process('recorder', args) as proc:
         try:
-            node = Recorder()
+            node = proc.add(Recorder())
         except (ConfigError, OSError) as exc:
-            logger.fatal(f'cannot record: {exc}')
+            proc.logger.fatal(f'cannot record: {exc}')
             return 2
-        node.spin_until(stop)
+        node.spin_until(proc.stop)
         taken = node.drain()
-        logger.info(f'stopped by {stop.reason}; {taken} queued messages written at the end')
+        proc.logger.info(f'stopped by {proc.stop.reason}; {taken} queued messages written at the end')
         node.close()
         return 0
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
 
 
 if __name__ == '__main__':

@@ -9,6 +9,7 @@ short timeout and checks it.
 from __future__ import annotations
 
 import signal
+from contextlib import contextmanager
 
 
 class StopRequest:
@@ -30,3 +31,33 @@ class StopRequest:
         signal.signal(signal.SIGINT, handler)
         signal.signal(signal.SIGTERM, handler)
         return self
+
+
+class NodeProcess:
+    """What a node's ``main`` works with: the stop request, a logger, the nodes to destroy."""
+
+    def __init__(self, name: str):
+        import rclpy
+        self.stop = StopRequest().install()
+        self.logger = rclpy.logging.get_logger(name)
+        self.nodes: list = []
+
+    def add(self, node):
+        self.nodes.append(node)
+        return node
+
+
+@contextmanager
+def node_process(name: str, args=None):
+    """rclpy initialised without its signal handlers (see above); at exit every node added
+    is destroyed and rclpy shut down, whatever happened."""
+    import rclpy
+    from rclpy.signals import SignalHandlerOptions
+    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    proc = NodeProcess(name)
+    try:
+        yield proc
+    finally:
+        for node in proc.nodes:
+            node.destroy_node()
+        rclpy.try_shutdown()

@@ -41,14 +41,13 @@ from rclpy.duration import Duration
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
-from rclpy.signals import SignalHandlerOptions
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 
 from ipfric_ros import topics
 from ipfric_ros.parameters import check_unknown, declare, declare_scenario
-from ipfric_ros.signals import StopRequest
+from ipfric_ros.signals import StopRequest, node_process
 
 from .safety import CommandGuard
 
@@ -352,35 +351,29 @@ class SimNode(Node):
 
 
 def main(args=None) -> int:
-    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
-    stop = StopRequest().install()
-    logger = rclpy.logging.get_logger('sim_node')
-    node = None
-    try:
-        node = SimNode(stop)
-        return node.run()
-    except ConfigError as exc:
-        logger.fatal(f'configuration error: {exc}')
-        return 2
-    except StartError as exc:
-        logger.fatal(str(exc))
-        if node is not None:
-            node.event('ABORT', str(exc))
-            node._flush(1.0)
-        return 1
-    except Exception as exc:  # an internal error still ends the run with a reason
-        logger.fatal(f'internal error: {type(exc).__name__}: {exc}')
-        if node is not None:
-            try:
-                node.event('ABORT', f'internal error: {type(exc).__name__}: {exc}')
+    with node_process('sim_node', args) as proc:
+        logger, node = proc.logger, None
+        try:
+            node = proc.add(SimNode(proc.stop))
+            return node.run()
+        except ConfigError as exc:
+            logger.fatal(f'configuration error: {exc}')
+            return 2
+        except StartError as exc:
+            logger.fatal(str(exc))
+            if node is not None:
+                node.event('ABORT', str(exc))
                 node._flush(1.0)
-            except Exception:
-                pass
-        raise
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+            return 1
+        except Exception as exc:  # an internal error still ends the run with a reason
+            logger.fatal(f'internal error: {type(exc).__name__}: {exc}')
+            if node is not None:
+                try:
+                    node.event('ABORT', f'internal error: {type(exc).__name__}: {exc}')
+                    node._flush(1.0)
+                except Exception:
+                    pass
+            raise
 
 
 if __name__ == '__main__':
