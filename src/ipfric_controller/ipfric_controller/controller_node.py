@@ -20,7 +20,6 @@ from __future__ import annotations
 import math
 import sys
 
-import rclpy
 from ipfric_core.closedloop import warm_up
 from ipfric_core.controller import delay_samples
 from ipfric_core.params import ConfigError
