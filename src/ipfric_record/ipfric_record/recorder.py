@@ -26,7 +26,6 @@ import sys
 import time
 from pathlib import Path
 
-import rclpy
 from ament_index_python.packages import get_package_share_directory
 from ipfric_core.params import ConfigError
 from ipfric_core.scenario import load_scenario

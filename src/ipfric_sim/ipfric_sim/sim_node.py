@@ -32,7 +32,6 @@ from collections import Counter
 
 import numpy as np
 
-import rclpy
 from builtin_interfaces.msg import Time
 from ipfric_core.closedloop import warm_up
 from ipfric_core.params import ConfigError
