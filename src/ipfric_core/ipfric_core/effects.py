@@ -16,6 +16,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .friction import COULOMB, DYNAMIC, EXPONENTIAL, VISCOUS, bristle_path, friction_forces
+from .rig import inputs_through
+
 
 @dataclass(frozen=True)
 class Param:
@@ -94,14 +97,12 @@ def shifted(t: np.ndarray, u: np.ndarray, delay: float) -> np.ndarray:
 
 
 def input_effects(t: np.ndarray, u: np.ndarray, p: dict, active) -> np.ndarray:
-    """u_eff: the input after delay, deadzone and saturation (same unit as u)."""
+    """u_eff: the input after delay, deadzone and saturation (same unit as u), the rig's law."""
     if 'delay' in active:
         u = shifted(t, u, p['delay'])
-    if 'deadzone' in active:
-        dz = p['dz']
-        u = np.where(np.abs(u) <= dz, 0.0, u - np.sign(u) * dz)
-    if 'saturation' in active:
-        u = np.clip(u, -p['u_max'], p['u_max'])
+    if 'deadzone' in active or 'saturation' in active:
+        u = inputs_through(np.ascontiguousarray(u, float), p['dz'] if 'deadzone' in active else 0.0,
+                           p['u_max'] if 'saturation' in active else 0.0)
     return u
 
 
@@ -138,25 +139,24 @@ def dwell_profile(t: np.ndarray, x: np.ndarray) -> np.ndarray:
     return D
 
 
-def stribeck_level(speed: np.ndarray, p: dict, active) -> np.ndarray:
-    """Sliding level g(v) [N]: Fc (+ (Fs - Fc) exp(-(|v|/v_s)^2)), eq. (8) with gamma = 2."""
-    g = np.full_like(speed, p.get('Fc', 0.0) if 'coulomb' in active else 0.0)
-    if 'stribeck' in active:
-        g = g + p['Fs_excess'] * np.exp(-(speed / p['v_s']) ** 2)
-    return g
+def friction_vector(p: dict, active) -> tuple:
+    """The identified friction as the parameter vector of :mod:`ipfric_core.friction`.
 
-
-def bristle_state(v: np.ndarray, level: np.ndarray, sigma0: float, dt: float) -> np.ndarray:
-    """Mean bristle deflection z [m] along v, eq. (10), integrated exactly per step (v held)."""
-    z = np.empty_like(v)
-    zk = 0.0
-    rate = sigma0 * np.abs(v) * dt / np.maximum(level, 1e-9)
-    decay = np.exp(-rate)
-    zss = np.sign(v) * level / sigma0
-    for k in range(len(v)):
-        zk = zss[k] + (zk - zss[k]) * decay[k] if v[k] != 0.0 else zk
-        z[k] = zk
-    return z
+    (model code, smoothing, eps, mu_s, mu_c, v_s, gamma, sigma0, sigma1, delta, F_N), see
+    :func:`ipfric_core.friction.parameter_vector`. Levels are in N (F_N = 1): mu_c = Fc, mu_s = Fc + Fs_excess, gamma = 2. Without the
+    stribeck effect the dynamic law's level stays at Fc. Fc is floored at 1e-9 N, where
+    the laws divide by the level.
+    """
+    if 'coulomb' not in active:
+        return (VISCOUS, 0.0, p['eps'], 0.0, 0.0, 1.0, 2.0, 0.0, 0.0, 0.0, 1.0)
+    fc = max(p['Fc'], 1e-9)
+    stribeck = 'stribeck' in active
+    if 'presliding' in active:
+        model, fs = DYNAMIC, fc + p['Fs_excess'] if stribeck else fc
+    else:
+        model, fs = (EXPONENTIAL if stribeck else COULOMB), fc + p['Fs_excess']
+    return (model, 0.0, p['eps'], fs, fc, p['v_s'] if stribeck else 1.0, 2.0,
+            p.get('sigma0', 0.0), p.get('sigma1', 0.0), 0.0, 1.0)
 
 
 def static_level(p: dict, active) -> float:
@@ -176,17 +176,16 @@ def position_force(x, p: dict, active):
 
 
 def resisting_force(x, v, p: dict, active, dt: float) -> np.ndarray:
-    """R [N]: the force the drive must supply against friction and the other forces."""
-    speed = np.abs(v)
-    sgn = np.sign(v)
-    r = p['eps'] * v
-    if 'coulomb' in active:
-        g = stribeck_level(speed, p, active)
-        if 'presliding' in active:
-            z = bristle_state(v, g, p['sigma0'], dt)
-            r = r + p['sigma0'] * z * (1.0 - p['sigma1'] * speed / np.maximum(g, 1e-9)) + p['sigma1'] * v
-        else:
-            r = r + g * sgn
+    """R [N]: the force the drive must supply against friction and the other forces.
+
+    The friction (viscous, coulomb, stribeck, presliding) is the law of
+    :mod:`ipfric_core.friction`, with the bristle state integrated along v.
+    """
+    v = np.ascontiguousarray(v, float)
+    fp = friction_vector(p, active)
+    z = bristle_path(fp, v, dt) if fp[0] == DYNAMIC else np.zeros_like(v)
+    r = -friction_forces(fp, v, z)
     if 'asymmetry' in active:
+        speed = np.abs(v)
         r = r + p['dFc'] * (speed > 0) + p['dFv'] * speed
     return r + position_force(x, p, active)

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 
 from .compiled import compiled
 from .params import FrictionParams
@@ -118,6 +119,34 @@ def bristle_rate(fp, v: float, z: float) -> float:
     if fp[MODEL] != DYNAMIC:
         return 0.0
     return v - fp[SIGMA0] * abs(v) * z / sliding_level(fp, v)
+
+
+@compiled
+def friction_forces(fp, v, z):
+    """:func:`friction_force` along sampled velocities ``v`` [m/s] and bristle states ``z`` [m]."""
+    out = np.empty(len(v))
+    for k in range(len(v)):
+        out[k] = friction_force(fp, v[k], z[k], 0.0)
+    return out
+
+
+@compiled
+def bristle_path(fp, v, dt: float):
+    """Bristle deflection z [m] along velocity samples ``v`` [m/s], each held for ``dt`` [s].
+
+    Eq. (10) with v constant is linear in z, z' = v - a z with a = sigma0 |v| / g(v):
+    each step is integrated exactly, z -> z_ss + (z - z_ss) exp(-a dt), z_ss = v / a.
+    Starts from z = 0; z holds while v = 0.
+    """
+    z = np.empty(len(v))
+    zk = 0.0
+    for k in range(len(v)):
+        if v[k] != 0.0:
+            a = fp[SIGMA0] * abs(v[k]) / sliding_level(fp, v[k])
+            zss = v[k] / a
+            zk = zss + (zk - zss) * math.exp(-a * dt)
+        z[k] = zk
+    return z
 
 
 class Friction:

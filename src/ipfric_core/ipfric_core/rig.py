@@ -12,6 +12,8 @@ import random
 from collections import deque
 from dataclasses import asdict, dataclass
 
+import numpy as np
+
 
 from .compiled import compiled
 from .encoder import quantize
@@ -64,6 +66,15 @@ def input_effects(voltage: float, deadzone: float, saturation: float) -> float:
     if saturation > 0.0:
         v = max(-saturation, min(saturation, v))
     return v
+
+
+@compiled
+def inputs_through(u, deadzone: float, saturation: float):
+    """:func:`input_effects` along sampled inputs ``u``."""
+    out = np.empty(len(u))
+    for k in range(len(u)):
+        out[k] = input_effects(u[k], deadzone, saturation)
+    return out
 
 
 def apply_input_effects(voltage: float, truth: PlantTruth) -> float:
