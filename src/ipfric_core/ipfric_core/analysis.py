@@ -8,13 +8,14 @@ from pathlib import Path
 import numpy as np
 
 from .bagread import RunData, read_run
+from .encoder import ANGLE_RESOLUTION_RAD, CART_RESOLUTION_M
 from .oscillation import classify
 from .plots import overlay_figure, run_figure
 
 
 def _resolution(run: RunData) -> tuple[float, float]:
     sim = (run.config or {}).get('sim', {})
-    return sim.get('cart_resolution', 4.54e-5), sim.get('angle_resolution', math.radians(0.08789))
+    return sim.get('cart_resolution', CART_RESOLUTION_M), sim.get('angle_resolution', ANGLE_RESOLUTION_RAD)
 
 
 def run_name(path: str | Path) -> str:

@@ -15,16 +15,15 @@ from pathlib import Path
 
 import yaml
 
-from .closedloop import run_closed_loop
 from .dataio import trajectory_record
 from .effects import BASE_MODELS
 from .identify import identify
 from .identreport import write_report
 from .lqr import design
-from .oscillation import classify
 from .params import ConfigError, FrictionParams, PlantParams
 from .rig import PlantTruth
 from .scenario import Scenario, load_scenario
+from .sweep import classify_run
 
 
 def identified_friction(r: dict) -> FrictionParams:
@@ -83,10 +82,6 @@ def designed_gain(plant: PlantParams, friction: FrictionParams, Q, R: float) -> 
     return [float(k) for k in design(plant, friction, Q, R).gain[:4]]
 
 
-def scenario_yaml(sim_section: dict, controller_section: dict) -> dict:
-    return {'sim_node': {'ros__parameters': sim_section}, 'controller_node': {'ros__parameters': controller_section}}
-
-
 def export_scenario(path: str | Path, r: dict, base: Scenario, rig: Scenario | None = None) -> dict:
     """Write the identified scenario to ``path`` (and ``<stem>_on_rig.yaml`` when ``rig`` is given).
 
@@ -99,34 +94,24 @@ def export_scenario(path: str | Path, r: dict, base: Scenario, rig: Scenario | N
     truth = identified_truth(r, base.sample_period)
     c = base.controller
     gain = designed_gain(base.plant, design_friction(friction), c.Q, c.R)
-    sim = {k: v for k, v in base.to_dict()['sim'].items()}
-    sim.update(plant=base.to_dict()['plant'], friction=friction.to_dict(),
-               plant_truth={k: v for k, v in truth.to_dict().items() if v != getattr(PlantTruth(), k)})
-    ctrl = {k: v for k, v in base.to_dict()['controller'].items()
-            if k not in ('gain_source', 'design_friction', 'plant', 'gain')}
-    ctrl.update(gain_source='yaml', gain=gain)
+    ctrl = replace(c, gain_source='yaml', gain=tuple(gain), design_friction=None)
     path.parent.mkdir(parents=True, exist_ok=True)
     header = (f'# Identified plant ({r["base_model"]} + {", ".join(r["effects_added"]) or "no effect"}) and the\n'
               f'# LQR gain designed on it. Written by ./ipfric identify --export.\n')
-    path.write_text(header + yaml.safe_dump(scenario_yaml(sim, ctrl), sort_keys=False))
+    identified = replace(base, friction=friction, truth=truth, controller=ctrl)
+    path.write_text(header + yaml.safe_dump(identified.to_ros_params(), sort_keys=False))
     load_scenario(path)  # the file must read back as a valid scenario
     out = {'scenario': str(path), 'friction': friction.to_dict(), 'plant_truth': truth.to_dict(), 'gain': gain}
     if rig is not None:
         on_rig = path.with_name(path.stem + '_on_rig.yaml')
-        rig_sim = rig.to_dict()['sim']
-        rig_sim.update(plant=rig.to_dict()['plant'], friction=rig.friction.to_dict(),
-                       plant_truth=rig.truth.to_dict())
         on_rig.write_text(f'# The rig of the identified run with the gain designed on the identified model.\n'
-                          + yaml.safe_dump(scenario_yaml(rig_sim, ctrl), sort_keys=False))
+                          + yaml.safe_dump(replace(rig, controller=ctrl).to_ros_params(), sort_keys=False))
         load_scenario(on_rig)
         out['on_rig'] = str(on_rig)
     return out
 
 
-def _oscillation(sc: Scenario, traj) -> dict:
-    o = classify(traj.t, traj.measured[:, 0], traj.measured[:, 1],
-                 (sc.sim.cart_resolution, sc.sim.angle_resolution), sc.sim.fallen_angle,
-                 traj.end_reason != 'duration')
+def _oscillation(o, traj) -> dict:
     return {'class': o.cls, 'x_p2p_m': o.x_p2p, 'theta_p2p_rad': o.theta_p2p, 'period_s': o.period_crossings,
             'end_reason': traj.end_reason}
 
@@ -136,16 +121,15 @@ def close_the_loop(scenario_path: str | Path, out: str | Path, duration: float =
     """Run, identify on the run's measured data, redesign, run again; amplitudes before/after."""
     out = Path(out)
     sc = load_scenario(scenario_path)
-    traj0 = run_closed_loop(sc.make_rig(), sc.make_controller(), duration)
-    before = _oscillation(sc, traj0)
+    o0, traj0 = classify_run(sc, duration)
+    before = _oscillation(o0, traj0)
     rec = trajectory_record(f'{Path(scenario_path).name}, gain {[round(k, 2) for k in sc.gain()]}',
                             traj0, sc.plant)
     est, val = rec.split(0.6)
     r = write_report(identify(est, val, base_model), out / 'identification', plots)
     exported = export_scenario(out / 'identified.yaml', r, sc, rig=sc)
     sc1 = load_scenario(exported['on_rig'])
-    traj1 = run_closed_loop(sc1.make_rig(), sc1.make_controller(), duration)
-    after = _oscillation(sc1, traj1)
+    after = _oscillation(*classify_run(sc1, duration))
     return {'scenario': str(scenario_path), 'duration_s': duration, 'gain_before': sc.gain(),
             'gain_after': exported['gain'], 'before': before, 'after': after,
             'identified': {k: r[k] for k in ('base_model', 'effects_added', 'friction', 'error_before',

@@ -31,6 +31,19 @@ def cell_scenario(base: Scenario, tau: float, theta0_deg: float) -> Scenario:
                    controller=replace(base.controller, delay=float(tau)))
 
 
+def classify_samples(scn: Scenario, t, x, theta, fell: bool, window: float = 10.0):
+    """:func:`classify` with the scenario's encoder counts and fallen angle."""
+    return classify(t, x, theta, (scn.sim.cart_resolution, scn.sim.angle_resolution), scn.sim.fallen_angle,
+                    ended_fallen=fell, window=window)
+
+
+def classify_run(scn: Scenario, duration: float, window: float = 10.0):
+    """Run ``scn`` offline for ``duration`` [s]; (its Oscillation from the measured positions, the Trajectory)."""
+    tr = run_closed_loop(scn.make_rig(), scn.make_controller(), duration)
+    return classify_samples(scn, tr.t, tr.measured[:, 0], tr.measured[:, 1], tr.end_reason != 'duration',
+                            window), tr
+
+
 def run_cell(base: Scenario, tau: float, theta0_deg: float, duration: float,
              ros_dir: str | Path | None = None) -> dict:
     """Run and classify one cell; returns a CSV row.
@@ -40,12 +53,9 @@ def run_cell(base: Scenario, tau: float, theta0_deg: float, duration: float,
     """
     scn = cell_scenario(base, tau, theta0_deg)
     if ros_dir is None:
-        tr = run_closed_loop(scn.make_rig(), scn.make_controller(), duration)
-        t, x, theta, fell = tr.t, tr.measured[:, 0], tr.measured[:, 1], tr.end_reason != 'duration'
+        o, _ = classify_run(scn, duration)
     else:
-        t, x, theta, fell = _ros_cell(scn, Path(ros_dir) / f'tau{tau:.4f}_theta{theta0_deg:.4f}', duration)
-    o = classify(t, x, theta, (scn.sim.cart_resolution, scn.sim.angle_resolution),
-                 scn.sim.fallen_angle, ended_fallen=fell)
+        o = classify_samples(scn, *_ros_cell(scn, Path(ros_dir) / f'tau{tau:.4f}_theta{theta0_deg:.4f}', duration))
     return {'tau_s': round(tau, 9), 'theta0_deg': round(theta0_deg, 9), 'class': o.cls,
             'transition_time_s': o.transition_time, 'x_p2p_m': o.x_p2p, 'theta_p2p_rad': o.theta_p2p,
             'period_s': o.period_crossings}
@@ -187,9 +197,7 @@ def resolution_cell(base: Scenario, scale: float, duration: float, sensor: str =
     scn = replace(base, sim=replace(
         s, cart_resolution=s.cart_resolution * (scale if sensor in ('cart', 'both') else 1.0),
         angle_resolution=s.angle_resolution * (scale if sensor in ('angle', 'both') else 1.0)))
-    tr = run_closed_loop(scn.make_rig(), scn.make_controller(), duration)
-    o = classify(tr.t, tr.measured[:, 0], tr.measured[:, 1], (scn.sim.cart_resolution, scn.sim.angle_resolution),
-                 scn.sim.fallen_angle, ended_fallen=tr.end_reason != 'duration')
+    o, tr = classify_run(scn, duration)
     w = tr.t >= tr.t[-1] - o.window[1] + o.window[0]      # the true motion over the same window
     return {'scale': float(scale), 'cart_resolution_m': scn.sim.cart_resolution,
             'angle_resolution_rad': scn.sim.angle_resolution, 'class': o.cls,
@@ -213,12 +221,7 @@ def threshold_angle(base: Scenario, lo: float, hi: float, duration: float, rtol:
     bistability of the equilibrium and a limit cycle). Stops when hi - lo < rtol * hi.
     """
     def cls(theta0):
-        scn = replace(base, sim=replace(base.sim, theta0=theta0))
-        tr = run_closed_loop(scn.make_rig(), scn.make_controller(), duration)
-        o = classify(tr.t, tr.measured[:, 0], tr.measured[:, 1],
-                     (scn.sim.cart_resolution, scn.sim.angle_resolution), scn.sim.fallen_angle,
-                     ended_fallen=tr.end_reason != 'duration', window=window)
-        return o
+        return classify_run(replace(base, sim=replace(base.sim, theta0=theta0)), duration, window)[0]
     c_lo, c_hi = cls(lo), cls(hi)
     if c_lo.cls != 'settled' or c_hi.cls == 'settled':
         raise ValueError(f'theta0 = {lo:g} rad gives {c_lo.cls} and {hi:g} rad gives {c_hi.cls}: '
