@@ -18,10 +18,10 @@ import math
 import mujoco
 import numpy as np
 
-from ipfric_core.closedloop import Trajectory
-from ipfric_core.compiled import compiled
-from ipfric_core.controller import feedback, filter_coefficient, filtered_rate
-from ipfric_core.encoder import quantize
+from ipfric_core.physics.closedloop import Trajectory
+from ipfric_core.physics.compiled import compiled
+from ipfric_core.physics.controller import feedback, filter_coefficient, filtered_rate
+from ipfric_core.physics.encoder import quantize
 
 MJCF = '''<mujoco model="ipfric cart-pendulum">
   <option timestep="{h}" gravity="0 0 -{g}" integrator="{integrator}"/>

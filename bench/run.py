@@ -22,11 +22,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ipfric_core.closedloop import run_closed_loop
-from ipfric_core.oscillation import classify, crossing_period
-from ipfric_core.paperconfig import REPO_ROOT
-from ipfric_core.scenario import load_scenario
-from ipfric_core.sweep import cell_scenario, parse_range, sweep
+from ipfric_core.physics.closedloop import run_closed_loop
+from ipfric_core.analysis.oscillation import classify, crossing_period
+from ipfric_core.design.paperconfig import REPO_ROOT
+from ipfric_core.run.scenario import load_scenario
+from ipfric_core.analysis.sweep import cell_scenario, parse_range, sweep
 
 CONFIG = REPO_ROOT / 'config'
 EMPS = REPO_ROOT.parent / 'shared' / 'data' / 'emps'
@@ -157,7 +157,7 @@ def bench_sweep(quick: bool) -> list[dict]:
 
 # -------------------------------------------------------------------------------------- ROS
 def _echo_rate(n: int) -> float:
-    from ipfric_core.runner import pick_domain, ros_environment
+    from ipfric_core.run.runner import pick_domain, ros_environment
     env = ros_environment(pick_domain())
     script = str(Path(__file__).with_name('ros_echo.py'))
     echo = subprocess.Popen([sys.executable, script, 'echo'], env=env, stdout=subprocess.DEVNULL,
@@ -175,7 +175,7 @@ def _echo_rate(n: int) -> float:
 
 
 def bench_ros(quick: bool, realtime_s: float, work: Path) -> tuple[list[dict], Path]:
-    from ipfric_core.runner import run
+    from ipfric_core.run.runner import run
     cfg = CONFIG / 'default.yaml'
     lock = run(cfg, work / 'lockstep', 1.0 if quick else 20.0)
     echo = _echo_rate(500 if quick else 5000)

@@ -13,16 +13,16 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from ipfric_core.closedloop import run_closed_loop
-from ipfric_core.friction import holds, static_limit, sticks
-from ipfric_core.plant import rates, stuck_theta_acceleration
-from ipfric_core.simulate import friction_now, held
+from ipfric_core.physics.closedloop import run_closed_loop
+from ipfric_core.physics.friction import holds, static_limit, sticks
+from ipfric_core.physics.plant import rates, stuck_theta_acceleration
+from ipfric_core.physics.simulate import friction_now, held
 
 RTOL, ATOL = 1e-10, 1e-12
 
 
 class ScipySimulator:
-    """Drop-in for :class:`ipfric_core.simulate.Simulator` (state, stuck, t, step, friction_force)."""
+    """Drop-in for :class:`ipfric_core.physics.simulate.Simulator` (state, stuck, t, step, friction_force)."""
 
     def __init__(self, model, state0, extra_force):
         self.pp, self.fp, self.ef = model.vector, model.friction.vector, extra_force

@@ -6,7 +6,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / 'src' / 'ipfric_core'))
 
-from ipfric_core.paperconfig import load_paper_config  # noqa: E402
+from ipfric_core.design.paperconfig import load_paper_config  # noqa: E402
 
 
 @pytest.fixture(scope='session')

@@ -1,7 +1,7 @@
 """Helpers of the ROS tests: scenario files, node processes and an in-process peer.
 
 Every process and the in-process rclpy context get a ROS_DOMAIN_ID of their own (a free
-one, :func:`ipfric_core.runner.pick_domain`) and ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST.
+one, :func:`ipfric_core.run.runner.pick_domain`) and ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST.
 """
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from ipfric_core.runner import executable, pick_domain, ros_environment
+from ipfric_core.run.runner import executable, pick_domain, ros_environment
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = ROOT / 'config'

@@ -2,7 +2,7 @@
 
 Subscribes ``joint_states`` (sensor_msgs/JointState, encoder positions of ``cart`` and
 ``pendulum``), estimates velocities by a filtered difference, computes
-V = sat(K (x, theta, x', theta')(t - tau)) with :class:`ipfric_core.controller.StateFeedback`
+V = sat(K (x, theta, x', theta')(t - tau)) with :class:`ipfric_core.physics.controller.StateFeedback`
 and publishes ``voltage_command`` (ipfric_msgs/VoltageCommand) carrying the stamp and the
 index of the measurement it was computed from (index = stamp / sample period).
 
@@ -20,10 +20,10 @@ from __future__ import annotations
 import math
 import sys
 
-from ipfric_core.closedloop import warm_up
-from ipfric_core.controller import delay_samples
-from ipfric_core.params import ConfigError
-from ipfric_core.scenario import Scenario
+from ipfric_core.physics.closedloop import warm_up
+from ipfric_core.physics.controller import delay_samples
+from ipfric_core.physics.params import ConfigError
+from ipfric_core.run.scenario import Scenario
 from ipfric_msgs.msg import VoltageCommand
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import Clock, ClockType

@@ -7,8 +7,8 @@ import math
 import sys
 from pathlib import Path
 
-from .params import ConfigError
-from .paperconfig import DEFAULT_CONFIG, DEFAULT_DATA, REPO_ROOT, load_paper_config
+from .physics.params import ConfigError
+from .design.paperconfig import DEFAULT_CONFIG, DEFAULT_DATA, REPO_ROOT, load_paper_config
 
 
 def _print_json(obj) -> None:
@@ -31,7 +31,7 @@ def _eig_text(pairs) -> str:
 
 
 def cmd_design(args) -> int:
-    from .reports import design_report
+    from .design.reports import design_report
     cfg = load_paper_config(args.config)
     rep = design_report(cfg, Path(args.data) / 'paper')
     if args.json:
@@ -64,7 +64,7 @@ def cmd_design(args) -> int:
 
 
 def cmd_stability(args) -> int:
-    from .reports import stability_report
+    from .design.reports import stability_report
     rep = stability_report(load_paper_config(args.config))
     if args.json:
         _print_json(rep)
@@ -85,8 +85,8 @@ def cmd_demo(args) -> int:
     """The README's main job: a closed-loop ROS 2 run of the default scenario, then its analysis."""
     import time
 
-    from .analysis import analyze_run
-    from .runner import Run
+    from .analysis.recorded_run import analyze_run
+    from .run.runner import Run
     out = Path(args.out) if args.out else REPO_ROOT / 'runs' / time.strftime('demo-%Y%m%d-%H%M%S')
     r = Run(args.config, out, args.duration, timeout=600.0)
     if not args.json:
@@ -114,7 +114,7 @@ def cmd_demo(args) -> int:
 
 
 def cmd_run(args) -> int:
-    from .runner import cmd_run as run
+    from .run.runner import cmd_run as run
     return run(args)
 
 
@@ -138,7 +138,7 @@ def _print_analysis(r: dict) -> None:
 
 
 def cmd_analyze(args) -> int:
-    from .analysis import analyze_run, overlay_runs
+    from .analysis.recorded_run import analyze_run, overlay_runs
     results = [analyze_run(p, None if args.no_plots else args.plots) for p in args.runs]
     out = {'runs': results}
     if len(args.runs) > 1 and not args.no_plots:
@@ -156,7 +156,7 @@ def cmd_analyze(args) -> int:
 def _sweep_base(config, sensors, smoothing, cutoff_hz=None):
     from dataclasses import replace
 
-    from .scenario import load_scenario
+    from .run.scenario import load_scenario
     base = load_scenario(config)
     if cutoff_hz is not None:
         if not (math.isfinite(cutoff_hz) and cutoff_hz >= 0):
@@ -179,8 +179,8 @@ FIGURE_GRIDS = (('full', '0.5:12:0.5'), ('zoom', '0.025:0.5:0.025'))
 
 
 def _figure_sweep(args, taus, progress) -> dict:
-    from .plots import transition_figure
-    from .sweep import boundaries, grid, parse_range, sweep
+    from .analysis.plots import transition_figure
+    from .analysis.sweep import boundaries, grid, parse_range, sweep
     name, variants = FIGURES[args.figure]
     config = REPO_ROOT / 'config' / name
     out = Path(args.out)
@@ -206,8 +206,8 @@ def _figure_sweep(args, taus, progress) -> dict:
 
 
 def _resolution_sweep(args, out: Path) -> int:
-    from .plots import resolution_figure
-    from .sweep import parse_range, resolution_study
+    from .analysis.plots import resolution_figure
+    from .analysis.sweep import parse_range, resolution_study
     try:
         scales = parse_range(args.resolution_scale)
     except ValueError as exc:
@@ -235,7 +235,7 @@ def _resolution_sweep(args, out: Path) -> int:
 
 
 def _threshold(args, out: Path) -> int:
-    from .sweep import threshold_angle
+    from .analysis.sweep import threshold_angle
     try:
         lo, hi = (float(v) for v in args.threshold.split(','))
     except ValueError as exc:
@@ -264,8 +264,8 @@ def _threshold(args, out: Path) -> int:
 
 
 def cmd_sweep(args) -> int:
-    from .plots import stability_map
-    from .sweep import boundaries, grid, parse_range, print_progress, sweep
+    from .analysis.plots import stability_map
+    from .analysis.sweep import boundaries, grid, parse_range, print_progress, sweep
     try:
         taus, ths = parse_range(args.tau), parse_range(args.theta0_deg)
     except ValueError as exc:
@@ -314,9 +314,9 @@ def cmd_sweep(args) -> int:
 
 def cmd_identify(args) -> int:
     """Identification on measured data, the paper tables, or the closed-loop redesign."""
-    from .effects import BASE_MODELS, EFFECTS
+    from .ident.effects import BASE_MODELS, EFFECTS
     if args.loop:
-        from .redesign import close_the_loop
+        from .ident.redesign import close_the_loop
         out = close_the_loop(args.loop, args.out, args.duration, args.base, not args.no_plots)
         if args.json:
             _print_json(out)
@@ -332,16 +332,16 @@ def cmd_identify(args) -> int:
         print(f'cart amplitude {b["x_p2p_m"] * 1000:.2f} mm before, {a["x_p2p_m"] * 1000:.2f} mm after; '
               f'report {out["report"]}; scenarios {out["export"]["scenario"]}, {out["export"]["on_rig"]}')
         return 0
-    from .params import PlantParams, load_yaml
+    from .physics.params import PlantParams, load_yaml
     plant = None  # a bag then uses the plant of its stored scenario, the rest Table 1
     if args.plant and 'sim_node' in load_yaml(args.plant):
-        from .scenario import load_scenario
+        from .run.scenario import load_scenario
         plant = load_scenario(args.plant).plant
     elif args.plant:
         plant = load_paper_config(args.plant).plant
     if args.data == 'paper':
-        from .estimation import load_table5, load_table6
-        from .identify import identify_steady
+        from .design.estimation import load_table5, load_table6
+        from .ident.identify import identify_steady
         d = Path(args.tables)
         V, v, _, _, aside = load_table5(d / 'table5_constant_voltage.csv')
         rep = identify_steady(plant or PlantParams(), V, v, load_table6(d / 'table6_breakaway_voltage.csv'))
@@ -356,9 +356,9 @@ def cmd_identify(args) -> int:
               f'{rep["breakaway_rms_N"]:.4f} N, curvature of the residual over the velocity range '
               f'{rep["residual_curvature_N"]:+.4f} N')
         return 0
-    from .dataio import load
-    from .identify import identify
-    from .identreport import write_report
+    from .ident.records import load
+    from .ident.identify import identify
+    from .ident.report import write_report
     columns = {}
     for item in args.columns.split(',') if args.columns else []:
         key, _, name = item.partition('=')
@@ -382,8 +382,8 @@ def cmd_identify(args) -> int:
         raise ConfigError(f'--base: {args.base!r} is not one of {", ".join(BASE_MODELS)}')
     r = write_report(identify(est, val, args.base, allowed), args.out, not args.no_plots)
     if args.export:
-        from .redesign import export_scenario
-        from .scenario import load_scenario
+        from .ident.redesign import export_scenario
+        from .run.scenario import load_scenario
         r['export'] = export_scenario(args.export, r, load_scenario(args.scenario),
                                       load_scenario(args.rig) if args.rig else None)
     if args.json:

@@ -8,7 +8,7 @@ message indexes and a Statistics record, as rosbag2 itself writes them. Each mes
 stamped with the recorder's wall clock when it is taken (as ``ros2 bag record`` does),
 never decreasing; the header stamps carry the simulated time.
 
-The run configuration (``scenario_file`` loaded by :func:`ipfric_core.scenario.load_scenario`:
+The run configuration (``scenario_file`` loaded by :func:`ipfric_core.run.scenario.load_scenario`:
 plant, friction, plant_truth, sim, controller and the gain) goes into the bag metadata
 as JSON under ``ipfric.config`` and as the parameter file text under ``ipfric.scenario_file``:
 in an MCAP metadata record ``ipfric`` and in ``custom_data`` of metadata.yaml (and of the
@@ -27,8 +27,8 @@ import time
 from pathlib import Path
 
 from ament_index_python.packages import get_package_share_directory
-from ipfric_core.params import ConfigError
-from ipfric_core.scenario import load_scenario
+from ipfric_core.physics.params import ConfigError
+from ipfric_core.run.scenario import load_scenario
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node

@@ -2,8 +2,8 @@
 
 Every parameter of a node section (``sim_node`` or ``controller_node``) is declared with
 its default, a description with the unit, its type and its numeric range
-(:meth:`ipfric_core.scenario.Scenario.flat_defaults`), then the values are nested again and
-validated by :func:`ipfric_core.scenario.scenario_from_ros_params`, the same code that
+(:meth:`ipfric_core.run.scenario.Scenario.flat_defaults`), then the values are nested again and
+validated by :func:`ipfric_core.run.scenario.scenario_from_ros_params`, the same code that
 checks a scenario file offline. Every problem is a :class:`ConfigError` naming the field.
 """
 from __future__ import annotations
@@ -12,8 +12,8 @@ import array
 import difflib
 import math
 
-from ipfric_core.params import ConfigError
-from ipfric_core.scenario import Scenario, nest, scenario_from_ros_params
+from ipfric_core.physics.params import ConfigError
+from ipfric_core.run.scenario import Scenario, nest, scenario_from_ros_params
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor, ParameterType
 from rclpy.exceptions import (InvalidParameterTypeException, InvalidParameterValueException,
                               ParameterException)

@@ -12,7 +12,7 @@ over [t_k, t_k+1) (zero-order hold). ``time_mode``:
 
 - ``lockstep``: sample k+1 is computed only after the command for sample k arrived (or
   ``lockstep_timeout_s`` of wall time passed): deterministic, faster than real time;
-  the same sequence as :func:`ipfric_core.closedloop.run_closed_loop`.
+  the same sequence as :func:`ipfric_core.physics.closedloop.run_closed_loop`.
 - ``realtime``: sample k at wall time t0 + k dt; the latest command is held.
 
 Safety (``safety_event``, ipfric_msgs/SafetyEvent): a NaN, infinite or out-of-range
@@ -33,8 +33,8 @@ from collections import Counter
 import numpy as np
 
 from builtin_interfaces.msg import Time
-from ipfric_core.closedloop import warm_up
-from ipfric_core.params import ConfigError
+from ipfric_core.physics.closedloop import warm_up
+from ipfric_core.physics.params import ConfigError
 from ipfric_msgs.msg import PlantState, SafetyEvent, VoltageCommand
 from rclpy.duration import Duration
 from rclpy.executors import SingleThreadedExecutor

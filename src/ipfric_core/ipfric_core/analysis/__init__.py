@@ -1,0 +1,59 @@
+"""Recorded runs analysed offline: the MCAP reader, oscillation classes, sweeps, plots.
+
+Modules: bagread, oscillation, plots, recorded_run, sweep. Every public name below is loaded from its module on
+first use, so importing the package stays cheap."""
+from __future__ import annotations
+
+import importlib
+
+#: public name -> module that defines it
+_WHERE = {
+    'CLASSES': 'oscillation',
+    'CLASS_COLOURS': 'plots',
+    'DECODED': 'bagread',
+    'FIELDS': 'sweep',
+    'MAGIC': 'bagread',
+    'Oscillation': 'oscillation',
+    'RECORDS': 'bagread',
+    'RunData': 'bagread',
+    'SCANNED': 'bagread',
+    'SENSORS': 'sweep',
+    'TRUTH_FIELDS': 'bagread',
+    'alignment_shift': 'recorded_run',
+    'analyze_run': 'recorded_run',
+    'boundaries': 'sweep',
+    'cell_scenario': 'sweep',
+    'classify': 'oscillation',
+    'classify_run': 'sweep',
+    'classify_samples': 'sweep',
+    'crossing_period': 'oscillation',
+    'grid': 'sweep',
+    'load_cells': 'sweep',
+    'mcap_file': 'bagread',
+    'overlay_figure': 'plots',
+    'overlay_runs': 'recorded_run',
+    'parse_range': 'sweep',
+    'print_progress': 'sweep',
+    'read_run': 'bagread',
+    'resolution_cell': 'sweep',
+    'resolution_figure': 'plots',
+    'resolution_study': 'sweep',
+    'run_cell': 'sweep',
+    'run_figure': 'plots',
+    'run_name': 'recorded_run',
+    'spectral_period': 'oscillation',
+    'stability_map': 'plots',
+    'sweep': 'sweep',
+    'threshold_angle': 'sweep',
+    'transition_figure': 'plots',
+}
+
+__all__ = sorted(_WHERE) + ['bagread', 'oscillation', 'plots', 'recorded_run', 'sweep']
+
+
+def __getattr__(name: str):
+    if name in _WHERE:
+        return getattr(importlib.import_module(f'.{_WHERE[name]}', __name__), name)
+    if name in __all__:
+        return importlib.import_module(f'.{name}', __name__)
+    raise AttributeError(f'module {__name__!r} has no attribute {name!r}')

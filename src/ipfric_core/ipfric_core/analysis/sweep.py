@@ -1,0 +1,241 @@
+"""Stability maps over the artificial delay tau and the initial angle theta0 (Figures 11-12).
+
+Each cell is one closed-loop run of a scenario with the controller delay and theta0
+replaced, classified by :func:`ipfric_core.analysis.oscillation.classify`. Cells run in parallel
+processes, are appended to ``cells.csv`` as they finish (so an interrupted sweep resumes
+without redoing them), and are deterministic: a cell's result depends only on its inputs.
+"""
+from __future__ import annotations
+
+import csv
+import math
+import os
+import sys
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import replace
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from ..physics.closedloop import run_closed_loop
+from .oscillation import CLASSES, classify
+from ..run.scenario import Scenario
+
+FIELDS = ('tau_s', 'theta0_deg', 'class', 'transition_time_s', 'x_p2p_m', 'theta_p2p_rad', 'period_s')
+
+
+def cell_scenario(base: Scenario, tau: float, theta0_deg: float) -> Scenario:
+    """``base`` with the feedback delay tau [s] and initial angle theta0 [deg]."""
+    return replace(base, sim=replace(base.sim, theta0=math.radians(float(theta0_deg))),
+                   controller=replace(base.controller, delay=float(tau)))
+
+
+def classify_samples(scn: Scenario, t, x, theta, fell: bool, window: float = 10.0):
+    """:func:`classify` with the scenario's encoder counts and fallen angle."""
+    return classify(t, x, theta, (scn.sim.cart_resolution, scn.sim.angle_resolution), scn.sim.fallen_angle,
+                    ended_fallen=fell, window=window)
+
+
+def classify_run(scn: Scenario, duration: float, window: float = 10.0):
+    """Run ``scn`` offline for ``duration`` [s]; (its Oscillation from the measured positions, the Trajectory)."""
+    tr = run_closed_loop(scn.make_rig(), scn.make_controller(), duration)
+    return classify_samples(scn, tr.t, tr.measured[:, 0], tr.measured[:, 1], tr.end_reason != 'duration',
+                            window), tr
+
+
+def run_cell(base: Scenario, tau: float, theta0_deg: float, duration: float,
+             ros_dir: str | Path | None = None) -> dict:
+    """Run and classify one cell; returns a CSV row.
+
+    With ``ros_dir`` the cell runs through the ROS 2 loop in lockstep (``./ipfric run``
+    into ``ros_dir/<cell>``) and is classified from its bag; otherwise the offline core runs it.
+    """
+    scn = cell_scenario(base, tau, theta0_deg)
+    if ros_dir is None:
+        o, _ = classify_run(scn, duration)
+    else:
+        o = classify_samples(scn, *_ros_cell(scn, Path(ros_dir) / f'tau{tau:.4f}_theta{theta0_deg:.4f}', duration))
+    return {'tau_s': round(tau, 9), 'theta0_deg': round(theta0_deg, 9), 'class': o.cls,
+            'transition_time_s': o.transition_time, 'x_p2p_m': o.x_p2p, 'theta_p2p_rad': o.theta_p2p,
+            'period_s': o.period_crossings}
+
+
+def _ros_cell(scn: Scenario, cell_dir: Path, duration: float):
+    """(t, x, theta, ended by a limit) of one lockstep ROS run of ``scn``."""
+    import shutil
+
+    import yaml
+
+    from .bagread import read_run
+    from ..run.runner import run
+    if cell_dir.exists():          # a cell interrupted before it reached cells.csv: run it again
+        shutil.rmtree(cell_dir)
+    cell_dir.mkdir(parents=True)
+    params = scn.to_ros_params()
+    params['sim_node']['ros__parameters']['time_mode'] = 'lockstep'
+    cfg = cell_dir / 'cell.yaml'
+    cfg.write_text(yaml.safe_dump(params, sort_keys=False))
+    res = run(cfg, cell_dir / 'run', duration=duration, timeout=60.0 + 2.0 * duration)
+    if res.exit_code != 0:
+        raise RuntimeError(f'ROS run of {cell_dir.name} failed:\n{res.summary()}')
+    bag = read_run(res.bag)
+    return bag.t, bag.x, bag.theta, bag.end_reason in ('FALLEN', 'TRACK_LIMIT')
+
+
+def _key(tau, theta0_deg) -> tuple:
+    return (round(float(tau), 9), round(float(theta0_deg), 9))
+
+
+def load_cells(path: Path) -> dict:
+    """Finished cells of an earlier (possibly interrupted) sweep; a torn last line is ignored."""
+    done = {}
+    if not path.exists():
+        return done
+    with open(path, newline='') as fh:
+        for row in csv.DictReader(fh):
+            try:
+                if row['class'] not in CLASSES:
+                    continue
+                typed = {k: (None if row[k] in ('', None) else float(row[k])) for k in FIELDS if k != 'class'}
+                typed['class'] = row['class']
+                done[_key(typed['tau_s'], typed['theta0_deg'])] = typed
+            except (KeyError, TypeError, ValueError):
+                continue
+    return done
+
+
+def sweep(base: Scenario, taus, thetas_deg, duration: float, out_dir: str | Path,
+          workers: int | None = None, progress: Callable[[int, int], None] | None = None,
+          ros: bool = False) -> list[dict]:
+    """Run every (tau, theta0) cell not already in ``out_dir/cells.csv``; return all rows sorted.
+
+    ``ros``: each cell through the ROS 2 loop in lockstep (bags kept in ``out_dir/ros``;
+    one cell at a time unless ``workers`` says otherwise, each cell being three processes).
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / 'cells.csv'
+    done = load_cells(path)
+    todo = [(t, th) for th in thetas_deg for t in taus if _key(t, th) not in done]
+    total = len(taus) * len(thetas_deg)
+    new_file = not path.exists() or not done
+    with open(path, 'w' if new_file else 'a', newline='') as fh:
+        w = csv.DictWriter(fh, FIELDS)
+        if new_file:
+            w.writeheader()
+        finished = total - len(todo)
+        if progress:
+            progress(finished, total)
+        ros_dir = out / 'ros' if ros else None
+        with ProcessPoolExecutor(max_workers=workers or (1 if ros else os.cpu_count())) as pool:
+            futures = [pool.submit(run_cell, base, t, th, duration, ros_dir) for t, th in todo]
+            for fut in as_completed(futures):
+                row = fut.result()
+                w.writerow(row)
+                fh.flush()
+                done[_key(row['tau_s'], row['theta0_deg'])] = row
+                finished += 1
+                if progress:
+                    progress(finished, total)
+    rows = [done[_key(t, th)] for th in thetas_deg for t in taus]
+    with open(path, 'w', newline='') as fh:  # rewrite in grid order: same inputs, same file
+        w = csv.DictWriter(fh, FIELDS)
+        w.writeheader()
+        w.writerows(rows)
+    return rows
+
+
+def grid(rows, taus, thetas_deg) -> list[list[str]]:
+    """Classes as a theta0-by-tau table."""
+    by = {_key(r['tau_s'], r['theta0_deg']): r['class'] for r in rows}
+    return [[by[_key(t, th)] for t in taus] for th in thetas_deg]
+
+
+def boundaries(rows, taus, thetas_deg) -> list[dict]:
+    """Per theta0: the largest tau still settled, the smallest not settled, the smallest that falls."""
+    g = grid(rows, taus, thetas_deg)
+    out = []
+    for th, row in zip(thetas_deg, g):
+        settled = [t for t, c in zip(taus, row) if c == 'settled']
+        unsettled = [t for t, c in zip(taus, row) if c != 'settled']
+        fallen = [t for t, c in zip(taus, row) if c == 'fallen']
+        out.append({'theta0_deg': float(th), 'last_settled_tau_s': max(settled) if settled else None,
+                    'first_unsettled_tau_s': min(unsettled) if unsettled else None,
+                    'first_fallen_tau_s': min(fallen) if fallen else None})
+    return out
+
+
+def parse_range(text: str) -> np.ndarray:
+    """'start:stop:step' (stop included) or 'a,b,c' -> array."""
+    try:
+        if ':' in text:
+            a, b, s = (float(v) for v in text.split(':'))
+            if s <= 0 or b < a:
+                raise ValueError
+            n = int(math.floor((b - a) / s + 1e-9)) + 1
+            return np.round(a + s * np.arange(n), 9)
+        return np.array([float(v) for v in text.split(',')])
+    except ValueError as exc:
+        raise ValueError(f'range {text!r}: expected start:stop:step with step > 0 and stop >= start, '
+                         f'or a comma-separated list of numbers') from exc
+
+
+def print_progress(done: int, total: int) -> None:
+    sys.stderr.write(f'\r[sweep] {done}/{total} cells')
+    if done == total:
+        sys.stderr.write('\n')
+    sys.stderr.flush()
+
+
+SENSORS = ('angle', 'cart', 'both')
+
+
+def resolution_cell(base: Scenario, scale: float, duration: float, sensor: str = 'angle') -> dict:
+    """One run with the ``sensor`` encoder count(s) multiplied by ``scale`` (0 = exact)."""
+    s = base.sim
+    scn = replace(base, sim=replace(
+        s, cart_resolution=s.cart_resolution * (scale if sensor in ('cart', 'both') else 1.0),
+        angle_resolution=s.angle_resolution * (scale if sensor in ('angle', 'both') else 1.0)))
+    o, tr = classify_run(scn, duration)
+    w = tr.t >= tr.t[-1] - o.window[1] + o.window[0]      # the true motion over the same window
+    return {'scale': float(scale), 'cart_resolution_m': scn.sim.cart_resolution,
+            'angle_resolution_rad': scn.sim.angle_resolution, 'class': o.cls,
+            'x_p2p_m': o.x_p2p, 'theta_p2p_rad': o.theta_p2p, 'period_s': o.period_crossings,
+            'true_x_p2p_m': float(np.ptp(tr.state[w, 0])), 'true_theta_p2p_rad': float(np.ptp(tr.state[w, 1]))}
+
+
+def resolution_study(base: Scenario, scales, duration: float, sensor: str = 'angle',
+                     workers: int | None = None) -> list[dict]:
+    """Oscillation against encoder resolution (section 6), one run per scale of the scenario's count(s)."""
+    n = len(scales)
+    with ProcessPoolExecutor(max_workers=workers or os.cpu_count()) as pool:
+        return list(pool.map(resolution_cell, [base] * n, scales, [duration] * n, [sensor] * n))
+
+
+def threshold_angle(base: Scenario, lo: float, hi: float, duration: float, rtol: float = 0.01,
+                    window: float = 20.0, progress: Callable[[float, float], None] | None = None) -> dict:
+    """Bisect the initial angle [rad] separating convergence from the periodic orbit.
+
+    Requires the run from ``lo`` to settle and the run from ``hi`` not to (Figure 8(b):
+    bistability of the equilibrium and a limit cycle). Stops when hi - lo < rtol * hi.
+    """
+    def cls(theta0):
+        return classify_run(replace(base, sim=replace(base.sim, theta0=theta0)), duration, window)[0]
+    c_lo, c_hi = cls(lo), cls(hi)
+    if c_lo.cls != 'settled' or c_hi.cls == 'settled':
+        raise ValueError(f'theta0 = {lo:g} rad gives {c_lo.cls} and {hi:g} rad gives {c_hi.cls}: '
+                         f'the bracket must go from settled to not settled')
+    runs = 2
+    while hi - lo > rtol * hi:
+        mid = math.sqrt(lo * hi) if lo > 0 else 0.5 * hi
+        o = cls(mid)
+        runs += 1
+        if o.cls == 'settled':
+            lo = mid
+        else:
+            hi, c_hi = mid, o
+        if progress:
+            progress(lo, hi)
+    return {'settles_below_rad': lo, 'oscillates_from_rad': hi, 'runs': runs,
+            'hi_class': c_hi.cls, 'hi_x_p2p_m': c_hi.x_p2p, 'hi_period_s': c_hi.period_crossings}

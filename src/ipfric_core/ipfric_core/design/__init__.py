@@ -1,0 +1,62 @@
+"""Design on the physics (paper sections 3-5): linearization, LQR, Routh-Hurwitz, the critical delay, friction estimates from the appendix tables, the printed numbers.
+
+Modules: critical_delay, estimation, linearize, lqr, paper, paperconfig, reports, stability. Every public name below is loaded from its module on
+first use, so importing the package stays cheap."""
+from __future__ import annotations
+
+import importlib
+
+#: public name -> module that defines it
+_WHERE = {
+    'BREAKAWAY_MEAN_V': 'paper',
+    'DEFAULT_CONFIG': 'paperconfig',
+    'DEFAULT_DATA': 'paperconfig',
+    'DELTA_COMPLEX_UNTIL': 'paper',
+    'DELTA_UNSTABLE_ABOVE': 'paper',
+    'Design': 'lqr',
+    'EIG_DYNAMIC_GAIN_15': 'paper',
+    'EIG_DYNAMIC_GAIN_25': 'paper',
+    'EPS': 'paper',
+    'GAIN_15_VISCOUS': 'paper',
+    'GAIN_23_EXPONENTIAL': 'paper',
+    'GAIN_25_DYNAMIC': 'paper',
+    'MU_C': 'paper',
+    'MU_S': 'paper',
+    'PaperConfig': 'paperconfig',
+    'REDUCED_GAIN_DYNAMIC': 'paper',
+    'REPO_ROOT': 'paperconfig',
+    'TAU_C_DYNAMIC': 'paper',
+    'TAU_C_EXPONENTIAL': 'paper',
+    'WEIGHT': 'paperconfig',
+    'characteristic_coefficients': 'linearize',
+    'closed_form': 'linearize',
+    'controllability_matrix': 'lqr',
+    'controllable_basis': 'lqr',
+    'coulomb_viscous': 'estimation',
+    'critical_delay': 'critical_delay',
+    'delayed_system': 'critical_delay',
+    'delta_thresholds': 'stability',
+    'design': 'lqr',
+    'design_report': 'reports',
+    'friction_estimates': 'reports',
+    'jacobian': 'linearize',
+    'load_paper_config': 'paperconfig',
+    'load_table5': 'estimation',
+    'load_table6': 'estimation',
+    'lqr_gain': 'lqr',
+    'rhp_root_count': 'stability',
+    'routh_first_column': 'stability',
+    'smooth_friction': 'linearize',
+    'stability_report': 'reports',
+    'static_coefficient': 'estimation',
+}
+
+__all__ = sorted(_WHERE) + ['critical_delay', 'estimation', 'linearize', 'lqr', 'paper', 'paperconfig', 'reports', 'stability']
+
+
+def __getattr__(name: str):
+    if name in _WHERE:
+        return getattr(importlib.import_module(f'.{_WHERE[name]}', __name__), name)
+    if name in __all__:
+        return importlib.import_module(f'.{name}', __name__)
+    raise AttributeError(f'module {__name__!r} has no attribute {name!r}')

@@ -1,0 +1,69 @@
+"""Open-loop identification experiment on the true rig: the cart driven by a multisine.
+
+The cart-alone experiment of an identification: the pendulum is taken off (a 1 mg
+stand-in hangs below the cart, its force is negligible and the friction's normal force
+is M g), the voltage is a sum of sines, and the rig's encoders and undeclared effects
+(:class:`rig.PlantTruth`) apply as in any run.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+
+from .records import Record, trajectory_record
+from ..physics.closedloop import Trajectory
+from ..physics.params import FrictionParams, PlantParams
+from ..physics.plant import CartPendulum
+from ..physics.rig import PlantTruth, Rig
+
+#: (amplitude [V], frequency [Hz], phase [rad]) of the default multisine
+MULTISINE = ((1.2, 0.4, 0.0), (0.6, 1.1, 1.0), (0.35, 2.7, 2.0), (0.2, 5.3, 0.5))
+
+
+def multisine(t: np.ndarray, components=MULTISINE, scale: float = 1.0) -> np.ndarray:
+    """V(t) = scale * sum A sin(2 pi f t + phi) [V]."""
+    return scale * sum(a * np.sin(2 * math.pi * f * t + ph) for a, f, ph in components)
+
+
+def cart_alone_run(plant: PlantParams, friction: FrictionParams, truth: PlantTruth, duration: float,
+                   dt: float = 1e-3, resolution: float = 4.54e-5, scale: float = 1.0) -> Record:
+    """Drive the cart alone with the multisine for ``duration`` [s]; the measured record."""
+    cart = replace(plant, m=1e-6)
+    model = CartPendulum(cart, friction, normal_force=plant.M * plant.g)
+    rig = Rig(model, truth, [0.0, math.pi, 0.0, 0.0], dt, (resolution, 0.0))
+    n = int(round(duration / dt)) + 1
+    t = np.arange(n) * dt
+    volts = multisine(t, scale=scale)
+    meas = np.empty((n, 2))
+    for k in range(n):
+        meas[k] = rig.measure()
+        if k < n - 1:
+            rig.step(float(volts[k]))
+    traj = Trajectory(t, np.zeros((n, 4)), meas, volts, np.zeros(n), np.zeros(n, bool), 'duration')
+    return trajectory_record('cart-alone multisine', traj, plant, cart_alone=True)
+
+
+class Dithered:
+    """A state-feedback controller with the multisine (scaled) added to its command.
+
+    Closed-loop identification: the dither keeps the cart moving while the pendulum
+    stays up, so the data show the friction over a range of velocities.
+    """
+
+    def __init__(self, controller, dt: float, scale: float = 0.3):
+        self.controller, self.dt, self.scale, self.k = controller, dt, scale, 0
+
+    def update(self, x: float, theta: float) -> float:
+        v = self.controller.update(x, theta) + float(multisine(np.array(self.k * self.dt), scale=self.scale))
+        self.k += 1
+        return v
+
+
+def dithered_run(scenario, duration: float, scale: float = 0.3) -> Record:
+    """Closed loop of ``scenario`` with a dither on the command; the measured record."""
+    from ..physics.closedloop import run_closed_loop
+    traj = run_closed_loop(scenario.make_rig(), Dithered(scenario.make_controller(), scenario.sample_period, scale),
+                           duration)
+    return trajectory_record('dithered closed loop', traj, scenario.plant)

@@ -1,0 +1,414 @@
+"""Identification of the cart's force balance with a greedy search over effects.
+
+Equation error on filtered derivatives: position and input are low-pass filtered with
+a zero-phase Butterworth filter (corner ``Record.cutoff_hz``), differentiated, and
+decimated to five samples per corner period. The force balance of
+:mod:`ipfric_core.ident.effects` is fitted by bounded nonlinear least squares
+(``scipy.optimize.least_squares``, trust region reflective); the standard errors come
+from the Jacobian at the optimum. Samples with |x'| below ``Record.stick_velocity``
+(the cart held by static friction: the friction force there is unknown), widened by one
+corner period, and the filter's start-up at both ends are left out of the force balance;
+static friction enters as inequalities on the stretches where the encoder stands still
+(held force <= Fs while stuck, >= Fs at the breakaway). With the pendulum, its own
+equation (no unknown parameter) is a further residual block.
+
+Search (:func:`identify`): fit the base model; then, round by round, refit with each
+remaining candidate effect, rank the candidates by how much estimation error each
+removes, and keep the best only if it pays on the validation data: the Bayesian
+information criterion on estimation drops, the validation RMS drops by more than
+``min_gain_percent``, and the drop is significant (p < P_VALUE in a block bootstrap
+over quarter-second blocks), and the effect is resolvable (:func:`resolved`). Stop when
+the residual is white or nothing pays.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import least_squares
+from scipy.signal import butter, sosfiltfilt
+
+from . import effects as fx
+from .records import Record
+from ..physics.params import ConfigError
+from .residual import signature_scores, whiteness
+
+MIN_GAIN_PERCENT = 1.0
+P_VALUE = 0.01
+BLOCK_S = 0.25
+BOOTSTRAP = 2000
+EDGE_S = 0.15
+TICK_S = 0.02
+STUCK_S = 0.05  # an encoder standing still this long [s] shows a stuck cart
+
+
+class Prepared:
+    """Filtered, differentiated and decimated signals of one record."""
+
+    def __init__(self, rec: Record):
+        self.rec = rec
+        dt = rec.dt
+        fs = 1.0 / dt
+        cutoff = min(rec.cutoff_hz, 0.4 * fs)
+        self.sos = butter(4, cutoff, fs=fs, output='sos')
+        self.q = max(1, int(fs / (5 * cutoff)))
+        t = rec.t
+        n = len(t)
+        self.idx = np.arange(0, n, self.q)
+        self.dt = dt * self.q
+        self.t_full = t
+        # the command u_k is held over [t_k, t_k+1): at t_k the force is the mean of u_k-1 and u_k
+        self.u_full = np.concatenate([[rec.u[0]], 0.5 * (rec.u[1:] + rec.u[:-1])])
+        self.t = t[self.idx]
+        self.u_raw = rec.u[self.idx]
+        self.x, self.v, self.a = self._derivatives(rec.x)
+        D = fx.dwell_profile(t, rec.x)
+        self.Dx, self.Dv, self.Da = (0.5 * s for s in self._derivatives(D))
+        self.has_theta = rec.theta is not None
+        if self.has_theta:
+            self.th, self.thd, self.thdd = self._derivatives(rec.theta)
+        self.uf_full = sosfiltfilt(self.sos, self.u_full)
+        self.uf = self.uf_full[self.idx]
+        self._breakaways(rec)
+        self.inside = (self.t >= t[0] + EDGE_S) & (self.t <= t[-1] - EDGE_S)
+        self.used = self.inside & ~self.near(np.abs(self.v) < rec.stick_velocity)
+        if self.used.sum() < 50:
+            raise ConfigError(f'{rec.name}: only {int(self.used.sum())} moving samples (|x\'| >= '
+                              f'{rec.stick_velocity:g} m/s); the data hardly move the axis')
+        self.n_used = int(self.used.sum())
+        steps = np.abs(np.diff(rec.x))
+        #: encoder count [m], the smallest step of x (a play below two counts is quantization)
+        self.resolution = float(steps[steps > 0].min())
+        self.vmax = float(np.quantile(np.abs(self.v[self.used]), 0.95))
+
+    def _breakaways(self, rec: Record) -> None:
+        """Samples where the encoder shows a stuck cart (every q-th sample of the stretches of at
+        least STUCK_S) and the breakaways that end them; the pendulum state there."""
+        self.b_idx = np.zeros(0, int)
+        self.b_kind = np.zeros(0)
+        if rec.stick_velocity <= 0:
+            return
+        t = rec.t
+        idx, kind = [], []
+        for a, b in fx.plateaus(t, rec.x, STUCK_S):
+            if t[a] < t[0] + EDGE_S or t[b] > t[-1] - EDGE_S:
+                continue
+            # the cart creeps within one count before it stops and after it breaks away: leave
+            # TICK_S at both ends of the stretch out
+            m = int(round(TICK_S / rec.dt))
+            held = list(range(a + m, b - m, self.q))
+            idx += held + [b]
+            kind += [1.0] * len(held) + [-1.0]
+        self.b_idx = np.array(idx, int)
+        self.b_kind = np.array(kind)
+        self.b_x = rec.x[self.b_idx]
+        if rec.theta is not None:
+            f = sosfiltfilt(self.sos, rec.theta)
+            self.b_th, self.b_thd = f[self.b_idx], np.gradient(f, t)[self.b_idx]
+
+    def near(self, stuck: np.ndarray) -> np.ndarray:
+        """``stuck`` widened by one corner period each side (the filter spreads a stick-slip
+        transition over about that much time)."""
+        k = max(1, int(round(1.0 / (self.rec.cutoff_hz * self.dt))))
+        if not stuck.any():
+            return stuck
+        return np.convolve(stuck.astype(float), np.ones(2 * k + 1), 'same') > 0
+
+    def _derivatives(self, y):
+        f = sosfiltfilt(self.sos, y)
+        v = np.gradient(f, self.rec.t)
+        a = np.gradient(v, self.rec.t)
+        return f[self.idx], v[self.idx], a[self.idx]
+
+
+@dataclass
+class Balance:
+    """Force balance at the decimated samples: input force y, model force, residual, weights."""
+
+    y: np.ndarray
+    model: np.ndarray
+    r: np.ndarray
+    used: np.ndarray
+    pendulum: np.ndarray | None
+    x: np.ndarray
+    v: np.ndarray
+    u: np.ndarray
+    static: np.ndarray  # violations of static friction [N]: stuck |held| > Fs or breakaway |held| < Fs
+
+
+def balance(pr: Prepared, p: dict, active) -> Balance:
+    """Evaluate the force balance of :mod:`effects` with parameters ``p``."""
+    rec = pr.rec
+    if any(fx.EFFECTS[e].acts_on == 'input' for e in active):
+        u = fx.input_effects(pr.t_full, pr.u_full, p, active)
+        uf_full = sosfiltfilt(pr.sos, u)
+    else:
+        uf_full = pr.uf_full
+    uf = uf_full[pr.idx]
+    y = rec.gain * uf
+    x, v, a = pr.x, pr.v, pr.a
+    if 'backlash' in active:
+        g = p['gap']
+        x, v, a = x + g * pr.Dx, v + g * pr.Dv, a + g * pr.Da
+    model = p['mass'] * a + rec.back_emf * v
+    pend = None
+    if pr.has_theta:
+        m, l, gr = rec.pendulum
+        th = pr.th - p.get('theta_bias', 0.0)
+        c, s = np.cos(th), np.sin(th)
+        model = model + m * (1 - 0.75 * c * c) * a - m * l * s * pr.thd ** 2 + 0.75 * m * gr * c * s
+        pend = m * ((4.0 / 3.0) * l * pr.thdd - gr * s + a * c)
+    model = model + fx.resisting_force(x, v, p, active, pr.dt)
+    used = pr.used
+    static = np.zeros(0)
+    if len(pr.b_idx):
+        # held force: input less the pendulum's reaction and the track forces, with the cart at rest
+        # (filtered like the rest: a command spike too short to move the cart past one count is
+        # smoothed as the cart's inertia smooths it)
+        held = rec.gain * uf_full[pr.b_idx] - fx.position_force(pr.b_x, p, active)
+        if pr.has_theta:
+            m, l, gr = rec.pendulum
+            th = pr.b_th - p.get('theta_bias', 0.0)
+            held = held - (0.75 * m * gr * np.cos(th) * np.sin(th) - m * l * np.sin(th) * pr.b_thd ** 2)
+        # stuck: static friction held it, |held| <= Fs; breakaway: |held| >= Fs (eq. 5)
+        static = np.maximum(0.0, pr.b_kind * (np.abs(held) - fx.static_level(p, active)))
+        if 'backlash' in active:  # a cart crossing the play moves while its encoder stands still
+            static = np.where(np.abs(v[np.minimum(pr.b_idx // pr.q, len(v) - 1)]) >= rec.stick_velocity,
+                              0.0, static)
+    return Balance(y, model, np.where(used, y - model, 0.0), used, pend, x, v, uf, static)
+
+
+def residual_vector(pr: Prepared, p: dict, active) -> np.ndarray:
+    b = balance(pr, p, active)
+    parts = [b.r, b.static]
+    if b.pendulum is not None:
+        parts.append(np.where(pr.inside, b.pendulum, 0.0))
+    return np.concatenate(parts)
+
+
+def param_specs(active) -> list:
+    specs = list(fx.BASE_PARAMS)
+    for e in active:
+        specs += list(fx.EFFECTS[e].params)
+    return specs
+
+
+@dataclass
+class Fit:
+    active: tuple
+    params: dict
+    std: dict
+    cost: float        # mean squared residual [N^2] over the used samples (+ pendulum block)
+    n: int
+
+    @property
+    def bic(self) -> float:
+        return self.n * math.log(max(self.cost, 1e-300)) + len(self.params) * math.log(self.n)
+
+
+def fit(pr: Prepared, active, start: dict) -> Fit:
+    """Bounded least squares of all parameters of ``active`` from ``start``."""
+    specs = param_specs(active)
+    names = [s.name for s in specs]
+    umax = float(np.max(np.abs(pr.u_full)))
+    # input effects may not switch the input off: a deadzone below half, a limit above a third of max |u|
+    lo = np.array([0.3 * umax if s.name == 'u_max' else s.lo for s in specs])
+    hi = np.array([0.5 * umax if s.name == 'dz' else s.hi for s in specs])
+    x0 = np.clip(np.array([start[nm] for nm in names], float), lo + 1e-12 * (hi - lo), hi - 1e-12 * (hi - lo))
+
+    def fun(theta):
+        return residual_vector(pr, dict(zip(names, theta)), active)
+    sol = least_squares(fun, x0, bounds=(lo, hi), x_scale='jac', max_nfev=200, method='trf')
+    r = sol.fun
+    n = pr.n_used + len(pr.b_idx) + (pr.inside.sum() if pr.has_theta else 0)
+    dof = max(1, n - len(names))
+    J = sol.jac
+    try:
+        norm = np.linalg.norm(J, axis=0)
+        scale = np.where(norm > 0, norm, 1.0)
+        Js = J / scale  # columns of unit norm: the parameters' units differ by many decades
+        cov = np.linalg.pinv(Js.T @ Js) / np.outer(scale, scale) * float(r @ r) / dof
+        std = np.sqrt(np.maximum(np.diag(cov), 0.0))
+        std[np.linalg.norm(J, axis=0) == 0.0] = np.nan  # the data say nothing about it
+    except np.linalg.LinAlgError:
+        std = np.full(len(names), np.nan)
+    p = dict(zip(names, map(float, sol.x)))
+    return Fit(tuple(active), p, dict(zip(names, map(float, std))), float(r @ r) / n, int(n))
+
+
+def starts(pr: Prepared, name: str, p: dict, active) -> list[dict]:
+    """Start values of effect ``name``'s parameters (several for the nonlinear ones)."""
+    b = balance(pr, p, active)
+    sig = signature_scores(b.r[b.used], pr.t[b.used], b.x[b.used], b.v[b.used], b.u[b.used], pr.dt)
+    base = {s.name: (s.init if s.init is not None else 0.0) for s in fx.EFFECTS[name].params}
+    u_scale = float(np.std(pr.u_full)) or 1.0
+    options = {
+        'stribeck': [{'v_s': f * pr.vmax} for f in (0.05, 0.2, 0.6)],
+        'coulomb': [{'Fc': 0.0, 'Fs_excess': 0.0}],
+        'presliding': [{'sigma0': max(p.get('Fc', 1.0), 1e-3) / z} for z in (1e-2, 1e-3, 1e-4, 1e-5)],
+        'cogging': [{'cog_period': sig['position_period_m'] or 0.01}],
+        'deadzone': [{'dz': f * u_scale} for f in (0.02, 0.1, 0.3)],
+        'saturation': [{'u_max': f * float(np.max(np.abs(pr.u_full)))} for f in (0.6, 0.8, 0.95)],
+        'backlash': [{'gap': g} for g in (1e-4, 1e-3, 3e-3, 1e-2)],
+        'delay': [{'delay': d} for d in sorted({sig['lag_s'], *np.geomspace(1e-3, 0.2, 10).tolist()})],
+    }.get(name, [{}])
+    return [{**p, **base, **o} for o in options]
+
+
+def best_fit(pr: Prepared, active, candidates: list[dict]) -> Fit:
+    """Fit from the start with the lowest initial cost (and from the best two if several)."""
+    costs = [float(np.mean(residual_vector(pr, c, active) ** 2)) for c in candidates]
+    order = np.argsort(costs)[:2]
+    fits = [fit(pr, active, candidates[i]) for i in order]
+    return min(fits, key=lambda f: f.cost)
+
+
+def errors(pr: Prepared, p: dict, active) -> dict:
+    """RMS [N] and relative error [%] = 100 ||F - F_model|| / ||F|| on the used samples."""
+    b = balance(pr, p, active)
+    r, y = b.r[b.used], b.y[b.used]
+    return {'rms': float(np.sqrt(np.mean(r ** 2))), 'relative_percent': float(100 * np.linalg.norm(r) /
+                                                                                 (np.linalg.norm(y) or 1.0)),
+            'samples': int(b.used.sum())}
+
+
+def resolved(pr: Prepared, name: str, f: Fit) -> bool:
+    """False for a play below two encoder counts (that is quantization), for a ripple with
+    fewer than five periods over the travel (the motion's own periodicity looks alike) and for
+    a deadzone whose force is below the residual's RMS."""
+    p = f.params
+    if name == 'deadzone':
+        return pr.rec.gain * p['dz'] > errors(pr, p, f.active)['rms']
+    if name == 'backlash':
+        return p['gap'] > 2 * pr.resolution
+    if name == 'cogging':
+        return np.ptp(pr.x) >= 5 * p['cog_period']
+    return True
+
+
+def total_rms(pr: Prepared, f: Fit) -> float:
+    """RMS of everything fitted: force balance, breakaways and pendulum equation."""
+    return float(np.sqrt(np.mean(residual_vector(pr, f.params, f.active) ** 2)))
+
+
+def block_test(pr: Prepared, before: Fit, after: Fit) -> float:
+    """p-value that the squared validation residual did not drop: block bootstrap of its drop
+    summed over time blocks of BLOCK_S seconds (the blocks keep the residual's correlation; an
+    effect confined to a few blocks, e.g. reversals, still counts by its size). Every residual
+    (force balance, static friction, pendulum) counts in its time block."""
+    r0 = residual_vector(pr, before.params, before.active)
+    r1 = residual_vector(pr, after.params, after.active)
+    d = r0 ** 2 - r1 ** 2
+    times = np.concatenate([pr.t, pr.t_full[pr.b_idx]] + ([pr.t] if pr.has_theta else []))
+    nb = max(10, min(60, int(len(pr.t) * pr.dt / BLOCK_S)))
+    block = np.minimum(((times - pr.t[0]) / (pr.t[-1] - pr.t[0] + 1e-12) * nb).astype(int), nb - 1)
+    sums = np.bincount(block, d, nb)
+    if not np.any(sums):
+        return 1.0
+    rng = np.random.default_rng(0)
+    boot = sums[rng.integers(0, nb, (BOOTSTRAP, nb))].sum(axis=1)
+    return float((np.sum(boot <= 0.0) + 1) / (BOOTSTRAP + 1))
+
+
+def analyse(pr: Prepared, f: Fit) -> dict:
+    b = balance(pr, f.params, f.active)
+    u = b.used
+    w = whiteness(b.r[u], b.u[u])
+    s = signature_scores(b.r[u], pr.t[u], b.x[u], b.v[u], b.u[u], pr.dt,
+                         None if b.pendulum is None else b.pendulum[pr.inside])
+    return {'whiteness': w, 'signatures': s}
+
+
+def explained(pr: Prepared, f: Fit) -> bool:
+    """True when the force residual is white and static friction is not violated beyond it."""
+    b = balance(pr, f.params, f.active)
+    rms = np.sqrt(np.mean(b.r[b.used] ** 2))
+    static_ok = not len(b.static) or np.sqrt(np.mean(b.static ** 2)) <= rms
+    return bool(static_ok and analyse(pr, f)['whiteness']['white'])
+
+
+def candidate_names(pr: Prepared, base: tuple, allowed=None) -> list[str]:
+    names = [n for n in fx.EFFECTS if n not in base and (allowed is None or n in allowed)]
+    return [n for n in names if pr.has_theta or not fx.EFFECTS[n].needs_theta]
+
+
+def identify(est: Record, val: Record, base_model: str = 'viscous', allowed=None,
+             max_rounds: int = 6, min_gain_percent: float = MIN_GAIN_PERCENT) -> dict:
+    """Fit ``base_model``, then search the effect library; returns the full result."""
+    if base_model not in fx.BASE_MODELS:
+        raise ConfigError(f'base model: {base_model!r} is not one of {", ".join(fx.BASE_MODELS)}')
+    pe, pv = Prepared(est), Prepared(val)
+    active = fx.BASE_MODELS[base_model]
+    start = {'mass': 1.0, 'eps': 0.0}
+    lin = fit(pe, (), start)  # viscous first: mass and eps are linear, a good start for any base
+    start = dict(lin.params)
+    for e in active:
+        start = best_fit(pe, tuple(active[:active.index(e) + 1]), starts(pe, e, start, active[:active.index(e)])).params
+    current = fit(pe, active, start) if active else lin
+    base_fit = current
+    tried, steps = [], [current]
+    for _ in range(max_rounds):
+        if explained(pe, current):
+            break
+        ranked = []
+        for name in candidate_names(pe, current.active, allowed):
+            req = fx.EFFECTS[name].requires
+            if any(r not in current.active for r in req):
+                continue
+            act = current.active + (name,)
+            f = best_fit(pe, act, starts(pe, name, current.params, current.active))
+            ranked.append((f.cost, name, f))
+        if not ranked:
+            break
+        ranked.sort(key=lambda z: z[0])
+        kept = False
+        for cost, name, f in ranked[:3]:
+            ev0, ev1 = total_rms(pv, current), total_rms(pv, f)
+            ee0, ee1 = total_rms(pe, current), total_rms(pe, f)
+            gain = 100 * (ev0 - ev1) / ev0
+            pval = block_test(pv, current, f)
+            resolvable = resolved(pe, name, f)
+            ok = bool(f.bic < current.bic and gain > min_gain_percent and pval < P_VALUE and resolvable)
+            tried.append({'name': name, 'estimation_gain_percent': 100 * (ee0 - ee1) / ee0,
+                          'validation_gain_percent': gain, 'validation_p': pval,
+                          'bic_drop': current.bic - f.bic, 'kept': ok})
+            if ok:
+                steps.append(f)
+                current, kept = f, True
+                break
+        if not kept:
+            break
+    return {'base_model': base_model, 'base_fit': base_fit, 'fit': current, 'tried': tried, 'steps': steps,
+            'prepared': (pe, pv)}
+
+
+def identify_steady(plant, volts, vels, breakaway_volts) -> dict:
+    """The cart-alone appendix experiments through the same force balance.
+
+    Steady sliding (Table 5, x'' = 0): alpha V = (beta + eps) v + Fc, the coulomb effect's
+    sliding branch; breakaway on a ramp (Table 6): alpha V_s = Fs = Fc + Fs_excess, its static
+    branch. One bounded least-squares fit of (eps, Fc, Fs_excess) with standard errors;
+    F_N = M g. The residual of the sliding rows is returned against velocity.
+    """
+    V, v, Vs = (np.asarray(a, float) for a in (volts, vels, breakaway_volts))
+    active = ('coulomb',)
+
+    def fun(theta):
+        p = {'eps': theta[0], 'Fc': theta[1], 'Fs_excess': theta[2]}
+        slide = plant.alpha * V - plant.beta * v - fx.resisting_force(np.zeros_like(v), v, p, active, 1.0)
+        return np.concatenate([slide, plant.alpha * Vs - fx.static_level(p, active)])
+    sol = least_squares(fun, [1.0, 0.1, 0.1], bounds=([0, 0, 0], [1e3, 1e3, 1e3]))
+    r = sol.fun
+    cov = np.linalg.inv(sol.jac.T @ sol.jac) * float(r @ r) / max(1, len(r) - 3)
+    std = np.sqrt(np.diag(cov))
+    fn = plant.M * plant.g
+    rs = r[:len(v)]
+    return {'eps': float(sol.x[0]), 'eps_std': float(std[0]),
+            'mu_c': float(sol.x[1] / fn), 'mu_c_std': float(std[1] / fn),
+            'mu_s': float((sol.x[1] + sol.x[2]) / fn), 'mu_s_std': float(np.hypot(std[1], std[2]) / fn),
+            'sliding_residual_N': rs.tolist(), 'velocity_mps': v.tolist(),
+            'sliding_rms_N': float(np.sqrt(np.mean(rs ** 2))),
+            'breakaway_rms_N': float(np.sqrt(np.mean(r[len(v):] ** 2))),
+            'residual_velocity_correlation': float(np.corrcoef(rs, v)[0, 1]),
+            'residual_curvature_N': float(np.polyfit(v, rs, 2)[0] * np.ptp(v) ** 2 / 4)}

@@ -1,0 +1,85 @@
+"""Physics of the rig (paper sections 2 and 6): parameters, friction laws, the plant, stick-slip integration, encoders and undeclared effects, the sampled controller and closed loop. Knows nothing of ROS, design or data.
+
+Modules: closedloop, compiled, controller, encoder, friction, params, plant, rig, simulate. Every public name below is loaded from its module on
+first use, so importing the package stays cheap."""
+from __future__ import annotations
+
+import importlib
+
+#: public name -> module that defines it
+_WHERE = {
+    'ANGLE_RESOLUTION_RAD': 'encoder',
+    'CART_RESOLUTION_M': 'encoder',
+    'CartPendulum': 'plant',
+    'ConfigError': 'params',
+    'END_REASONS': 'closedloop',
+    'ENGINES': 'closedloop',
+    'FRICTION_FIELDS': 'params',
+    'FRICTION_MODELS': 'params',
+    'FRICTION_REQUIRED': 'params',
+    'Field': 'params',
+    'Friction': 'friction',
+    'FrictionParams': 'params',
+    'MAX_EVENTS': 'simulate',
+    'MODEL_CODES': 'friction',
+    'NO_EXTRA_FORCE': 'plant',
+    'PLANT_FIELDS': 'params',
+    'PlantParams': 'params',
+    'PlantTruth': 'rig',
+    'Rig': 'rig',
+    'SMOOTHING': 'params',
+    'Simulator': 'simulate',
+    'StateFeedback': 'controller',
+    'Trajectory': 'closedloop',
+    'XTOL': 'simulate',
+    'accelerations': 'plant',
+    'advance': 'simulate',
+    'apply_input_effects': 'rig',
+    'bristle_path': 'friction',
+    'bristle_rate': 'friction',
+    'check_choice': 'params',
+    'check_keys': 'params',
+    'check_number': 'params',
+    'compiled': 'compiled',
+    'compiled_unsupported': 'closedloop',
+    'delay_samples': 'controller',
+    'feedback': 'controller',
+    'filter_coefficient': 'controller',
+    'filtered_rate': 'controller',
+    'friction_force': 'friction',
+    'friction_forces': 'friction',
+    'friction_now': 'simulate',
+    'held': 'simulate',
+    'held_force': 'plant',
+    'holds': 'friction',
+    'input_effects': 'rig',
+    'inputs_through': 'rig',
+    'load_yaml': 'params',
+    'motor_force': 'plant',
+    'parameter_vector': 'friction',
+    'play': 'rig',
+    'quantize': 'encoder',
+    'rates': 'plant',
+    'rk4_slide': 'simulate',
+    'rk4_stuck': 'simulate',
+    'run_closed_loop': 'closedloop',
+    'sensor_reading': 'rig',
+    'sliding_level': 'friction',
+    'static_friction': 'friction',
+    'static_limit': 'friction',
+    'sticks': 'friction',
+    'stribeck_level': 'friction',
+    'stuck_theta_acceleration': 'plant',
+    'undeclared_force': 'plant',
+    'warm_up': 'closedloop',
+}
+
+__all__ = sorted(_WHERE) + ['closedloop', 'compiled', 'controller', 'encoder', 'friction', 'params', 'plant', 'rig', 'simulate']
+
+
+def __getattr__(name: str):
+    if name in _WHERE:
+        return getattr(importlib.import_module(f'.{_WHERE[name]}', __name__), name)
+    if name in __all__:
+        return importlib.import_module(f'.{name}', __name__)
+    raise AttributeError(f'module {__name__!r} has no attribute {name!r}')

@@ -1,0 +1,139 @@
+"""Nonlinear cart-pendulum, paper eq. (1) with the motor force (2), first-order form (16).
+
+State (SI): s = (x [m], theta [rad from upright], x' [m/s], theta' [rad/s]) and, for the
+dynamic friction model, z [m] (bristle deflection) as a fifth entry.
+
+The equations are written once, as scalar functions compiled by numba on a plant vector
+``pp`` = (M, m, l, g, alpha, beta) (:func:`parameter_vector`) and the friction vector ``fp``
+of :mod:`ipfric_core.physics.friction`; :class:`CartPendulum` and the compiled integrator of
+:mod:`ipfric_core.physics.simulate` both call them.
+"""
+from __future__ import annotations
+
+import math
+
+
+from .compiled import compiled
+from .friction import Friction, bristle_rate, friction_force
+from .params import FrictionParams, PlantParams
+
+# Positions in the plant vector.
+M, MP, L, G, ALPHA, BETA = range(6)
+
+
+def parameter_vector(plant: PlantParams) -> tuple:
+    """(M [kg], m [kg], l [m], g [m/s^2], alpha [N/V], beta [N s/m]) as floats."""
+    return tuple(float(v) for v in (plant.M, plant.m, plant.l, plant.g, plant.alpha, plant.beta))
+
+
+@compiled
+def motor_force(pp, voltage: float, x_dot: float) -> float:
+    """F = alpha V - beta x' [N], eq. (2)."""
+    return pp[ALPHA] * voltage - pp[BETA] * x_dot
+
+
+@compiled
+def accelerations(pp, theta: float, theta_dot: float, force: float):
+    """(x'', theta'') from eq. (16) for a total horizontal force on the cart [N]."""
+    m, l, g = pp[MP], pp[L], pp[G]
+    s, c = math.sin(theta), math.cos(theta)
+    den = pp[M] + m - 0.75 * m * c * c
+    xdd = (force + m * l * s * theta_dot ** 2 - 0.75 * m * g * c * s) / den
+    thdd = (-force * c - m * l * s * c * theta_dot ** 2 + (pp[M] + m) * g * s) / ((4.0 / 3.0) * l * den)
+    return xdd, thdd
+
+
+@compiled
+def held_force(pp, theta: float, theta_dot: float, force: float) -> float:
+    """Force static friction must cancel to keep the cart at rest [N] (eq. 5's F_applied).
+
+    With x'' = 0, eq. (1) gives theta'' = 3 g sin(theta) / (4 l) and the horizontal
+    force on the resting cart is ``force`` + m l sin(theta) theta'^2 - m l cos(theta)
+    theta''; it includes the pendulum's reaction.
+    """
+    m, l = pp[MP], pp[L]
+    s, c = math.sin(theta), math.cos(theta)
+    return force + m * l * s * theta_dot ** 2 - 0.75 * m * pp[G] * c * s
+
+
+@compiled
+def stuck_theta_acceleration(pp, theta: float) -> float:
+    """theta'' [rad/s^2] while the cart is held at rest: 3 g sin(theta) / (4 l)."""
+    return 0.75 * pp[G] * math.sin(theta) / pp[L]
+
+
+@compiled
+def undeclared_force(ef, x: float, v: float) -> float:
+    """Force on the cart [N] from effects the friction model does not declare.
+
+    ``ef`` = (cogging amplitude [N], cogging period [m], asymmetry [N]): a position-periodic
+    cogging force A sin(2 pi x / P), and a constant -asymmetry while the cart moves (the
+    Coulomb level raised forward, lowered backward). (0, 1, 0) = none.
+    """
+    f = ef[0] * math.sin(2 * math.pi * x / ef[1]) if ef[0] != 0.0 else 0.0
+    if v != 0.0:
+        f -= ef[2]
+    return f
+
+
+NO_EXTRA_FORCE = (0.0, 1.0, 0.0)
+
+
+@compiled
+def rates(pp, fp, ef, s, voltage: float, direction: float):
+    """ds/dt of the sliding (or smooth) motion, eq. (16) with (17) and the friction law.
+
+    ``s`` = (x, theta, x', theta', z) (z = 0 unless the law is dynamic); ``direction``
+    fixes sgn(x') of a sticking law over a step. Returns the 5 rates.
+    """
+    x_dot, theta, theta_dot, z = s[2], s[1], s[3], s[4]
+    f = (motor_force(pp, voltage, x_dot) + friction_force(fp, x_dot, z, direction)
+         + undeclared_force(ef, s[0], x_dot))
+    xdd, thdd = accelerations(pp, theta, theta_dot, f)
+    return x_dot, theta_dot, xdd, thdd, bristle_rate(fp, x_dot, z)
+
+
+class CartPendulum:
+    """Equations of motion of the rig with a given friction law.
+
+    Parameters
+    ----------
+    plant : PlantParams
+    friction : FrictionParams
+    normal_force : float, optional
+        F_N [N] for the friction law; default (M + m) g as in the paper.
+    """
+
+    def __init__(self, plant: PlantParams, friction: FrictionParams,
+                 normal_force: float | None = None):
+        self.p = plant
+        fn = plant.normal_force if normal_force is None else normal_force
+        self.friction = Friction(friction, fn)
+        self.n_states = 4 + self.friction.n_states
+        #: The plant as the parameter vector of the scalar functions.
+        self.vector = parameter_vector(plant)
+
+    def motor_force(self, voltage: float, x_dot: float) -> float:
+        """F = alpha V - beta x' [N], eq. (2)."""
+        return motor_force(self.vector, voltage, x_dot)
+
+    def accelerations(self, theta: float, theta_dot: float, force: float) -> tuple[float, float]:
+        """(x'', theta'') from eq. (16) for a total horizontal force on the cart [N].
+
+        ``force`` = F + F_fric (+ any extra force on the cart).
+        """
+        return accelerations(self.vector, theta, theta_dot, force)
+
+    def held_force(self, theta: float, theta_dot: float, force: float) -> float:
+        """Force static friction must cancel to keep the cart at rest [N] (:func:`held_force`)."""
+        return held_force(self.vector, theta, theta_dot, force)
+
+    def stuck_theta_acceleration(self, theta: float) -> float:
+        """theta'' [rad/s^2] while the cart is held at rest: 3 g sin(theta) / (4 l)."""
+        return stuck_theta_acceleration(self.vector, theta)
+
+    def derivative(self, state, voltage: float, direction: float = 0.0) -> list[float]:
+        """ds/dt of the sliding (or smooth) motion (:func:`rates`), as long as ``state``."""
+        s = [float(v) for v in state] + [0.0] * (5 - len(state))
+        out = rates(self.vector, self.friction.vector, NO_EXTRA_FORCE, tuple(s), voltage, direction)
+        return list(out[:self.n_states])

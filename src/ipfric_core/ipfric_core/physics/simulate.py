@@ -1,0 +1,255 @@
+"""Time integration of the nonlinear cart-pendulum with exact stick-slip.
+
+:class:`Simulator` advances the plant over one sample with the voltage held constant
+(zero-order hold). Smooth laws are integrated with classical RK4 substeps. A sticking
+law (coulomb, exponential without smoothing) is integrated as a hybrid system:
+
+- sliding: RK4 with sgn(x') fixed to the direction of motion; when x' reaches zero
+  inside a substep the crossing instant is located (Brent's method on the RK4 step
+  length), the state is placed there with x' = 0, and the cart sticks if static
+  friction can hold it (``friction.holds`` on ``plant.held_force``, which includes the
+  pendulum's reaction), otherwise it slides the other way;
+- stuck: x, x' are frozen, the pendulum swings with theta'' = 3 g sin(theta)/(4 l); the
+  breakaway instant where |held force| reaches mu_s F_N is located the same way.
+
+Events are located, never stepped over, so the motion neither chatters around v = 0
+nor stalls.
+
+The integrator is compiled by numba (:func:`advance`) and calls the scalar physics of
+:mod:`ipfric_core.physics.plant` and :mod:`ipfric_core.physics.friction`; its state is a 5-tuple
+(x, theta, x', theta', z) and a mode (stuck 0/1, direction of motion, event count).
+"""
+from __future__ import annotations
+
+import math
+
+
+from .compiled import compiled
+from .friction import friction_force, holds, static_limit, sticks
+from .plant import (NO_EXTRA_FORCE, CartPendulum, held_force, motor_force, rates,
+                    stuck_theta_acceleration, undeclared_force)
+
+MAX_EVENTS = 64  # per substep; a guard, never reached in normal motion
+XTOL = 1e-13     # event time tolerance [s]
+
+
+@compiled
+def rk4_slide(pp, fp, ef, s, h, voltage, d):
+    """One RK4 step of length ``h`` [s] of the sliding motion with sgn(x') = ``d``."""
+    k1 = rates(pp, fp, ef, s, voltage, d)
+    s2 = (s[0] + 0.5 * h * k1[0], s[1] + 0.5 * h * k1[1], s[2] + 0.5 * h * k1[2],
+          s[3] + 0.5 * h * k1[3], s[4] + 0.5 * h * k1[4])
+    k2 = rates(pp, fp, ef, s2, voltage, d)
+    s3 = (s[0] + 0.5 * h * k2[0], s[1] + 0.5 * h * k2[1], s[2] + 0.5 * h * k2[2],
+          s[3] + 0.5 * h * k2[3], s[4] + 0.5 * h * k2[4])
+    k3 = rates(pp, fp, ef, s3, voltage, d)
+    s4 = (s[0] + h * k3[0], s[1] + h * k3[1], s[2] + h * k3[2], s[3] + h * k3[3], s[4] + h * k3[4])
+    k4 = rates(pp, fp, ef, s4, voltage, d)
+    c = h / 6.0
+    return (s[0] + c * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0]),
+            s[1] + c * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1]),
+            s[2] + c * (k1[2] + 2 * k2[2] + 2 * k3[2] + k4[2]),
+            s[3] + c * (k1[3] + 2 * k2[3] + 2 * k3[3] + k4[3]),
+            s[4] + c * (k1[4] + 2 * k2[4] + 2 * k3[4] + k4[4]))
+
+
+@compiled
+def rk4_stuck(pp, s, h):
+    """One RK4 step of the pendulum over the resting cart (x, x' frozen)."""
+    th, w = s[1], s[3]
+    k1t, k1w = w, stuck_theta_acceleration(pp, th)
+    k2t, k2w = w + 0.5 * h * k1w, stuck_theta_acceleration(pp, th + 0.5 * h * k1t)
+    k3t, k3w = w + 0.5 * h * k2w, stuck_theta_acceleration(pp, th + 0.5 * h * k2t)
+    k4t, k4w = w + h * k3w, stuck_theta_acceleration(pp, th + h * k3t)
+    return (s[0], th + h / 6.0 * (k1t + 2 * k2t + 2 * k3t + k4t), 0.0,
+            w + h / 6.0 * (k1w + 2 * k2w + 2 * k3w + k4w), s[4])
+
+
+@compiled
+def held(pp, ef, s, voltage):
+    """Force static friction must cancel to keep the cart at rest in state ``s`` [N]."""
+    return held_force(pp, s[1], s[3], motor_force(pp, voltage, 0.0) + undeclared_force(ef, s[0], 0.0))
+
+
+@compiled
+def _event(kind, pp, fp, ef, s, tau, voltage, d, level):
+    """Event functions of the step length tau [s], each changing sign at the event.
+
+    kind 0 (breakaway): |held force| - mu_s F_N after tau stuck; kind 1 (stop): x' d after
+    tau sliding, with ``level`` = |x'| at tau = 0.
+    """
+    if kind == 0:
+        return abs(held(pp, ef, rk4_stuck(pp, s, tau), voltage)) - level
+    if tau <= 0.0:
+        return level
+    return rk4_slide(pp, fp, ef, s, tau, voltage, d)[2] * d
+
+
+@compiled
+def _locate(kind, pp, fp, ef, s, hi, voltage, d, level):
+    """Root in (0, hi) of :func:`_event` by Brent's method (as scipy's brentq), tolerance XTOL."""
+    xpre, xcur = 0.0, hi
+    fpre = _event(kind, pp, fp, ef, s, xpre, voltage, d, level)
+    fcur = _event(kind, pp, fp, ef, s, xcur, voltage, d, level)
+    if fpre == 0.0:
+        return xpre
+    if fcur == 0.0:
+        return xcur
+    xblk = fblk = spre = scur = 0.0
+    for _ in range(200):
+        if fpre != 0.0 and fcur != 0.0 and (fpre < 0.0) != (fcur < 0.0):
+            xblk, fblk = xpre, fpre
+            spre = scur = xcur - xpre
+        if abs(fblk) < abs(fcur):
+            xpre, xcur, xblk = xcur, xblk, xcur
+            fpre, fcur, fblk = fcur, fblk, fcur
+        delta = (XTOL + 4.44e-16 * abs(xcur)) / 2
+        sbis = (xblk - xcur) / 2
+        if fcur == 0.0 or abs(sbis) < delta:
+            return xcur
+        if abs(spre) > delta and abs(fcur) < abs(fpre):
+            if xpre == xblk:
+                stry = -fcur * (xcur - xpre) / (fcur - fpre)
+            else:
+                dpre = (fpre - fcur) / (xpre - xcur)
+                dblk = (fblk - fcur) / (xblk - xcur)
+                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
+            if 2 * abs(stry) < min(abs(spre), 3 * abs(sbis) - delta):
+                spre, scur = scur, stry
+            else:
+                spre, scur = sbis, sbis
+        else:
+            spre, scur = sbis, sbis
+        xpre, fpre = xcur, fcur
+        if abs(scur) > delta:
+            xcur += scur
+        else:
+            xcur += delta if sbis > 0 else -delta
+        fcur = _event(kind, pp, fp, ef, s, xcur, voltage, d, level)
+    return xcur
+
+
+@compiled
+def _settle(pp, fp, ef, s, voltage, events):
+    """At x' = 0: stick if static friction holds, else slide along the held force."""
+    applied = held(pp, ef, s, voltage)
+    if holds(fp, applied):
+        return (s[0], s[1], 0.0, s[3], s[4]), (1.0, 0.0, events + 1.0)
+    return s, (0.0, math.copysign(1.0, applied), events + 1.0)
+
+
+@compiled
+def _advance_hybrid(pp, fp, ef, s, mode, h, voltage):
+    stuck, d, events = mode
+    lim = static_limit(fp)
+    remaining = h
+    for _ in range(MAX_EVENTS):
+        if remaining <= 0.0:
+            return s, (stuck, d, events)
+        if stuck != 0.0:
+            applied = held(pp, ef, s, voltage)
+            if not holds(fp, applied):
+                stuck, d, events = 0.0, math.copysign(1.0, applied), events + 1.0
+                continue
+            new = rk4_stuck(pp, s, remaining)
+            if holds(fp, held(pp, ef, new, voltage)):
+                return new, (stuck, d, events)
+            tb = _locate(0, pp, fp, ef, s, remaining, voltage, 0.0, lim)
+            tb = min(remaining, tb * (1 + 1e-9) + 1e-15)  # step just past the threshold
+            s = rk4_stuck(pp, s, tb)
+            remaining -= tb
+            stuck, d, events = 0.0, math.copysign(1.0, held(pp, ef, s, voltage)), events + 1.0
+            continue
+        if d == 0.0:
+            if s[2] == 0.0:
+                s, (stuck, d, events) = _settle(pp, fp, ef, s, voltage, events)
+                continue
+            d = math.copysign(1.0, s[2])
+        new = rk4_slide(pp, fp, ef, s, remaining, voltage, d)
+        if new[2] * d > 0.0:
+            return new, (stuck, d, events)
+        start = max(abs(s[2]), 1e-300)  # the motion starts along d by construction
+        tc = _locate(1, pp, fp, ef, s, remaining, voltage, d, start)
+        s = rk4_slide(pp, fp, ef, s, tc, voltage, d)
+        s = (s[0], s[1], 0.0, s[3], s[4])
+        remaining -= tc
+        s, (stuck, d, events) = _settle(pp, fp, ef, s, voltage, events)
+    # Guard (more than MAX_EVENTS transitions in one substep): finish it sliding.
+    return rk4_slide(pp, fp, ef, s, remaining, voltage, d), (stuck, d, events)
+
+
+@compiled
+def advance(pp, fp, ef, s, mode, voltage, dt, substep):
+    """State and mode after ``dt`` [s] with ``voltage`` [V] held, in RK4 substeps <= ``substep``."""
+    n = max(1, math.ceil(dt / substep - 1e-9))
+    h = dt / n
+    hybrid = sticks(fp)
+    for _ in range(n):
+        if hybrid:
+            s, mode = _advance_hybrid(pp, fp, ef, s, mode, h, voltage)
+        else:
+            s = rk4_slide(pp, fp, ef, s, h, voltage, mode[1])
+    return s, mode
+
+
+@compiled
+def friction_now(pp, fp, ef, s, mode, voltage):
+    """Friction force on the cart in state ``s`` and ``mode`` [N] (static while stuck)."""
+    if mode[0] != 0.0:
+        return -held(pp, ef, s, voltage)
+    return friction_force(fp, s[2], s[4], mode[1])
+
+
+class Simulator:
+    """Stateful integrator of one plant.
+
+    Parameters
+    ----------
+    model : CartPendulum
+    state0 : sequence
+        Initial (x, theta, x', theta'[, z]) [SI]; missing z defaults to 0.
+    substep : float
+        Largest RK4 step [s] (default 0.25 ms, four per 1 kHz sample).
+    extra_force : (cogging [N], cogging period [m], asymmetry [N]), optional
+        Forces on the cart the friction model does not know (:func:`plant.undeclared_force`).
+    """
+
+    def __init__(self, model: CartPendulum, state0, substep: float = 2.5e-4,
+                 extra_force: tuple = NO_EXTRA_FORCE):
+        self.model = model
+        s = [float(v) for v in state0][:model.n_states]
+        self._s = tuple(s + [0.0] * (5 - len(s)))
+        self._mode = (0.0, 0.0, 0.0)  # stuck, direction of motion of a sticking law, events
+        self.t = 0.0
+        self.substep = float(substep)
+        self.extra_force = tuple(float(v) for v in extra_force)
+        self._pp, self._fp = model.vector, model.friction.vector
+
+    @property
+    def state(self) -> list:
+        """(x, theta, x', theta'[, z]) [SI]."""
+        return list(self._s[:self.model.n_states])
+
+    @property
+    def stuck(self) -> bool:
+        """True while static friction holds the cart."""
+        return self._mode[0] != 0.0
+
+    @property
+    def events(self) -> int:
+        """Number of stick/slip transitions so far."""
+        return int(self._mode[2])
+
+    def held_force(self, s, voltage: float) -> float:
+        """Force static friction must cancel at rest [N] (with x' = 0)."""
+        return held(self._pp, self.extra_force, (float(s[0]), float(s[1]), 0.0, float(s[3]), 0.0), voltage)
+
+    def friction_force(self, voltage: float) -> float:
+        """Friction force on the cart in the current state [N]."""
+        return friction_now(self._pp, self._fp, self.extra_force, self._s, self._mode, voltage)
+
+    def step(self, voltage: float, dt: float) -> None:
+        """Advance by ``dt`` [s] with the voltage held at ``voltage`` [V]."""
+        self._s, self._mode = advance(self._pp, self._fp, self.extra_force, self._s, self._mode,
+                                      float(voltage), float(dt), self.substep)
+        self.t += dt

@@ -1,0 +1,407 @@
+"""``./ipfric run``: one closed-loop run of the ROS 2 nodes, recorded to a rosbag2 MCAP.
+
+Starts three processes in a fresh ROS domain with DDS kept on loopback
+(``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``): the recorder, the controller and the
+simulator, each from ``ros2_ws/install/<pkg>/lib/<pkg>/`` with
+``--ros-args --params-file <OUT>/scenario.yaml``. Nothing waits a fixed time: the
+controller announces itself (latched ``controller_gain``) once its command publisher is
+matched by the simulator and the recorder, and the simulator starts sample 0 only when
+that message arrived and the recorder subscribes to each of its topics.
+
+The run ends when the simulator exits (duration reached, a limit crossed, or stopped);
+then the controller and the recorder are stopped with SIGINT, in that order, so that the
+recorder takes every queued message and closes the bag. Ctrl-C does the same. A node
+that dies ends the run with a non-zero exit and a message naming it; the bag recorded up
+to that moment stays readable (as long as the recorder itself is alive).
+
+Output directory ``OUT``: ``bag/`` (metadata.yaml + bag.mcap), ``scenario.yaml`` (the
+parameter file the nodes got, duration applied), ``sim_result.json`` (end reason, samples,
+published counts, speed), ``summary.json`` and ``logs/<node>.log``.
+
+This module starts processes only; it imports no ROS package.
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import random
+import signal
+import socket
+import subprocess
+import sys
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import yaml
+
+from ..physics.params import ConfigError, load_yaml
+from .scenario import load_scenario
+
+ROOT = Path(os.environ.get('IPFRIC_ROOT') or Path(__file__).resolve().parents[4])
+
+#: The processes of a run in start order: name -> (package, executable).
+NODES = {
+    'recorder': ('ipfric_record', 'recorder'),
+    'controller_node': ('ipfric_controller', 'controller_node'),
+    'sim_node': ('ipfric_sim', 'sim_node'),
+}
+CONFIG_NAME = 'scenario.yaml'
+
+
+# ---------------------------------------------------------------------------- environment
+def ros_environment(domain: int) -> dict:
+    """The environment of scripts/env.sh plus the run's domain, DDS on loopback only."""
+    env_sh = ROOT / 'scripts' / 'env.sh'
+    out = subprocess.run(['bash', '-c', f'set -e; source "{env_sh}" >/dev/null; env -0'],
+                         capture_output=True, check=True)
+    env = dict(item.split('=', 1) for item in out.stdout.decode().split('\0') if '=' in item)
+    env.update(ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
+               RCUTILS_COLORIZED_OUTPUT='0', PYTHONUNBUFFERED='1')
+    return env
+
+
+def domain_in_use(domain: int) -> bool:
+    """True when the first participant's unicast discovery port of ``domain`` is taken.
+
+    Fast DDS: port = 7400 + 250 * domain + 10 (+ 2 per further participant).
+    """
+    port = 7400 + 250 * domain + 10
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        try:
+            s.bind(('0.0.0.0', port))
+        except OSError:
+            return True
+    return False
+
+
+def pick_domain(rng: random.Random | None = None) -> int:
+    """A ROS_DOMAIN_ID in 1..232 that no participant on this machine uses."""
+    rng = rng or random.Random(os.getpid() ^ time.monotonic_ns())
+    candidates = list(range(1, 233))
+    rng.shuffle(candidates)
+    for d in candidates:
+        if not domain_in_use(d):
+            return d
+    raise RuntimeError('no free ROS domain id in 1..232')
+
+
+def executable(name: str) -> Path:
+    pkg, exe = NODES[name]
+    path = ROOT / 'ros2_ws' / 'install' / pkg / 'lib' / pkg / exe
+    if not path.exists():
+        raise FileNotFoundError(f'{path} not found: build the workspace (bash scripts/setup.sh)')
+    return path
+
+
+def describe_exit(code: int | None) -> str:
+    if code is None:
+        return 'still running'
+    if code < 0:
+        try:
+            return f'killed by {signal.Signals(-code).name}'
+        except ValueError:
+            return f'killed by signal {-code}'
+    return f'exit code {code}'
+
+
+def last_problem(log: Path) -> str:
+    """The last FATAL/ERROR line (or traceback line) of a node log, for the message."""
+    try:
+        lines = log.read_text(errors='replace').splitlines()
+    except OSError:
+        return ''
+    for line in reversed(lines):
+        if '[FATAL]' in line or '[ERROR]' in line or 'Error' in line:
+            return line.strip()
+    return ''
+
+
+# ---------------------------------------------------------------------------- the run
+@dataclass
+class RunResult:
+    exit_code: int
+    end_reason: str | None
+    detail: str | None
+    out: str
+    bag: str
+    domain: int
+    samples: int | None = None
+    sim_time_s: float | None = None
+    wall_time_s: float | None = None
+    steps_per_s: float | None = None
+    published: dict = field(default_factory=dict)
+    recorded: dict = field(default_factory=dict)
+    counts_match: bool | None = None
+    failures: list = field(default_factory=list)
+    interrupted: bool = False
+    exit_codes: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    def summary(self) -> str:
+        lines = []
+        if self.end_reason:
+            lines.append(f'run: {self.end_reason} ({self.detail}) after {self.samples} samples '
+                         f'({self.sim_time_s:.3f} s simulated) in {self.wall_time_s:.1f} s wall '
+                         f'({self.steps_per_s:.0f} samples/s), ROS domain {self.domain}')
+        else:
+            lines.append(f'run: no end reason (the simulator did not finish), ROS domain {self.domain}')
+        if self.recorded:
+            lines.append(f'bag: {self.bag} (rosbag2, MCAP), '
+                         + ', '.join(f'{t} {n}' for t, n in self.recorded.items()))
+        else:
+            lines.append(f'bag: {self.bag}: not readable (no metadata.yaml)')
+        if self.counts_match is not None:
+            lines.append('recorded == published by sim_node: ' + ('yes' if self.counts_match else 'NO'))
+        for f in self.failures:
+            lines.append(f'FAILED: {f}')
+        if self.interrupted:
+            lines.append('interrupted (Ctrl-C): all nodes stopped')
+        lines.append(f'logs: {Path(self.out) / "logs"}')
+        return '\n'.join(lines)
+
+
+class Run:
+    """One run: :meth:`start`, then :meth:`wait` (or use :func:`run`).
+
+    Parameters
+    ----------
+    config : scenario parameter file (sim_node / controller_node sections)
+    out : output directory (created; must not hold a bag yet)
+    duration : simulated seconds, overriding the file's sim_node duration (None = keep)
+    domain : ROS_DOMAIN_ID (None = a free one)
+    timeout : wall seconds after which the simulator is stopped (None = none)
+    grace : wall seconds the simulator may run on after the controller died (its
+        watchdog acts) before it is stopped
+    stop_wait : wall seconds the simulator has to end after SIGINT before it is killed
+    """
+
+    def __init__(self, config, out, duration: float | None = None, domain: int | None = None,
+                 timeout: float | None = None, grace: float = 20.0, sim_params: dict | None = None,
+                 stop_wait: float = 20.0):
+        self.config = Path(config)
+        self.out = Path(out).resolve()  # the nodes run with cwd = out
+        self.duration = duration
+        self.domain = domain
+        self.timeout = timeout
+        self.grace = grace
+        self.stop_wait = stop_wait
+        self.sim_params = dict(sim_params or {})
+        self.procs: dict[str, subprocess.Popen] = {}
+        self.logs: dict[str, Path] = {}
+        self.failures: list[str] = []
+        self.interrupted = False
+        self._files = []
+
+    # -- start -----------------------------------------------------------------------------
+    def prepare(self) -> Path:
+        """Validate the scenario and write OUT/scenario.yaml (raises ConfigError)."""
+        load_scenario(self.config)
+        data = load_yaml(self.config)
+        if self.duration is not None:
+            if not (math.isfinite(self.duration) and self.duration >= 0):
+                raise ConfigError(f'--duration: {self.duration!r} must be >= 0 s')
+            data['sim_node']['ros__parameters']['duration'] = float(self.duration)
+        self.out.mkdir(parents=True, exist_ok=True)
+        if (self.out / 'bag').exists():
+            raise ConfigError(f'{self.out / "bag"} exists already; choose another --out')
+        path = self.out / CONFIG_NAME
+        header = f'# ipfric run of {self.config}' + (
+            f' with duration {self.duration:g} s' if self.duration is not None else '') + '\n'
+        path.write_text(header + yaml.safe_dump(data, sort_keys=False))
+        load_scenario(path)
+        return path
+
+    def start(self) -> None:
+        cfg = self.prepare()
+        if self.domain is None:
+            self.domain = pick_domain()
+        env = ros_environment(self.domain)
+        logdir = self.out / 'logs'
+        logdir.mkdir(exist_ok=True)
+        env['ROS_LOG_DIR'] = str(logdir / 'ros')
+        sim_params = {'wait_for_recorder': 'true', 'result_file': str(self.out / 'sim_result.json')}
+        sim_params.update({k: str(v).lower() if isinstance(v, bool) else str(v)
+                           for k, v in self.sim_params.items()})
+        args = {
+            'recorder': ['-p', f'output:={self.out / "bag"}', '-p', f'scenario_file:={cfg}'],
+            'controller_node': ['--params-file', str(cfg), '-p', 'min_command_subscribers:=2',
+                                '-p', 'use_sim_time:=true'],
+            'sim_node': ['--params-file', str(cfg)] + [a for k, v in sim_params.items()
+                                                        for a in ('-p', f'{k}:={v}')],
+        }
+        self.t0 = time.monotonic()
+        for name in NODES:
+            exe = executable(name)
+            self.logs[name] = logdir / f'{name}.log'
+            f = open(self.logs[name], 'w')
+            self._files.append(f)
+            self.procs[name] = subprocess.Popen([str(exe), '--ros-args', *args[name]], env=env, cwd=self.out,
+                                                stdout=f, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+                                                start_new_session=True)
+
+    def kill(self) -> None:
+        """SIGKILL every process still running (last resort, e.g. a failed test)."""
+        for name, p in self.procs.items():
+            if p.poll() is None:
+                self._signal(name, signal.SIGKILL)
+                p.wait()
+
+    # -- supervision -----------------------------------------------------------------------
+    def _died(self, name: str) -> str:
+        p = self.procs[name]
+        why = last_problem(self.logs[name])
+        return f'{name} {describe_exit(p.returncode)} ({self.logs[name]})' + (f': {why}' if why else '')
+
+    def _signal(self, name: str, sig=signal.SIGINT) -> None:
+        p = self.procs.get(name)
+        if p is not None and p.poll() is None:
+            try:
+                p.send_signal(sig)
+            except ProcessLookupError:
+                pass
+
+    def _stop(self, name: str, wait: float) -> None:
+        """SIGINT, then SIGTERM, then SIGKILL, each after ``wait`` s."""
+        p = self.procs[name]
+        for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGKILL):
+            if p.poll() is not None:
+                return
+            self._signal(name, sig)
+            try:
+                p.wait(timeout=wait)
+                return
+            except subprocess.TimeoutExpired:
+                if sig == signal.SIGKILL:
+                    raise
+
+    def supervise(self) -> None:
+        """Return once the simulator exited (stopping it on timeout, Ctrl-C or a dead peer)."""
+        sim = self.procs['sim_node']
+        stop_at = None
+        signalled = None    # when the simulator was asked to stop
+        reported = set()
+        while sim.poll() is None:
+            try:
+                time.sleep(0.05)
+            except KeyboardInterrupt:
+                self.interrupted = True
+                stop_at = time.monotonic()
+            now = time.monotonic()
+            if signalled is not None:
+                if now - signalled > self.stop_wait:
+                    self.failures.append(f'sim_node did not stop within {self.stop_wait:g} s of SIGINT; killed')
+                    self._stop('sim_node', 5.0)
+                continue
+            for name in ('recorder', 'controller_node'):
+                if name not in reported and self.procs[name].poll() is not None:
+                    reported.add(name)
+                    self.failures.append(self._died(name) + ' before the run ended')
+                    # the recorder gone: nothing is kept any more, stop now; the controller
+                    # gone: the simulator's watchdog acts, let it finish for a while
+                    delay = 0.0 if name == 'recorder' else self.grace
+                    stop_at = min(stop_at or math.inf, now + delay)
+            if self.timeout is not None and now - self.t0 > self.timeout and 'timeout' not in reported:
+                reported.add('timeout')
+                self.failures.append(f'sim_node still running after the {self.timeout:g} s timeout; stopped')
+                stop_at = now
+            if stop_at is not None and now >= stop_at:
+                self._signal('sim_node')
+                signalled = now
+        if sim.returncode != 0:
+            self.failures.append(self._died('sim_node'))
+
+    def wait(self) -> RunResult:
+        try:
+            self.supervise()
+            for name, wait in (('sim_node', 20.0), ('controller_node', 10.0), ('recorder', 30.0)):
+                alive = self.procs[name].poll() is None
+                self._stop(name, wait)
+                code = self.procs[name].returncode
+                if alive and code != 0 and name != 'sim_node':
+                    self.failures.append(f'{name} did not stop cleanly: {self._died(name)}')
+        except KeyboardInterrupt:  # a second Ctrl-C: no more patience
+            self.interrupted = True
+            self.kill()
+            self.failures.append('stopped hard by a second Ctrl-C; the bag may be incomplete')
+        finally:
+            for f in self._files:
+                f.close()
+        return self.result()
+
+    # -- result ----------------------------------------------------------------------------
+    def result(self) -> RunResult:
+        sim = {}
+        try:
+            sim = json.loads((self.out / 'sim_result.json').read_text())
+        except (OSError, ValueError):
+            pass
+        recorded = {}
+        try:
+            meta = yaml.safe_load((self.out / 'bag' / 'metadata.yaml').read_text())
+            for t in meta['rosbag2_bagfile_information']['topics_with_message_count']:
+                recorded[t['topic_metadata']['name']] = t['message_count']
+        except (OSError, ValueError, KeyError, TypeError, yaml.YAMLError):
+            pass
+        published = sim.get('published', {})
+        match = None
+        if published and recorded:
+            match = all(recorded.get(t) == n for t, n in published.items())
+        if match is False:
+            self.failures.append('recorded counts differ from the published counts: '
+                                 f'published {published}, recorded {recorded}')
+        code = 0
+        if self.failures:
+            code = 1
+        elif self.interrupted:
+            code = 130
+        res = RunResult(exit_code=code, end_reason=sim.get('end_reason'), detail=sim.get('detail'),
+                        out=str(self.out), bag=str(self.out / 'bag'), domain=self.domain,
+                        samples=sim.get('samples'), sim_time_s=sim.get('sim_time_s'),
+                        wall_time_s=sim.get('wall_time_s'), steps_per_s=sim.get('steps_per_s'),
+                        published=published, recorded=recorded, counts_match=match,
+                        failures=list(self.failures), interrupted=self.interrupted,
+                        exit_codes={n: p.returncode for n, p in self.procs.items()})
+        (self.out / 'summary.json').write_text(json.dumps(res.to_dict(), indent=2))
+        return res
+
+
+def run(config, out, duration: float | None = None, **kwargs) -> RunResult:
+    """Start, supervise and stop one run; see :class:`Run`."""
+    r = Run(config, out, duration, **kwargs)
+    r.start()
+    return r.wait()
+
+
+def cmd_run(args) -> int:
+    """``./ipfric run``: the command line front end (SIGINT and SIGTERM stop the run cleanly)."""
+    def to_interrupt(_signum, _frame):
+        raise KeyboardInterrupt
+    # explicit: a shell without job control starts background commands with SIGINT ignored
+    signal.signal(signal.SIGINT, to_interrupt)
+    signal.signal(signal.SIGTERM, to_interrupt)
+    r = Run(args.config, args.out, args.duration, domain=args.domain, timeout=args.timeout)
+    try:
+        r.start()
+    except KeyboardInterrupt:
+        r.kill()
+        return 130
+    except FileNotFoundError as exc:
+        print(f'ipfric run: {exc}', file=sys.stderr)
+        return 1
+    if not args.json:
+        print(f'ipfric run: {args.config} -> {args.out} (ROS domain {r.domain}, DDS on loopback); '
+              f'Ctrl-C stops the run and keeps the bag', file=sys.stderr)
+    res = r.wait()
+    if args.json:
+        json.dump(res.to_dict(), sys.stdout, indent=2)
+        sys.stdout.write('\n')
+    else:
+        print(res.summary())
+    if res.failures:
+        for f in res.failures:
+            print(f'ipfric run: {f}', file=sys.stderr)
+    return res.exit_code

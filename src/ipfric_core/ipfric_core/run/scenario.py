@@ -1,0 +1,318 @@
+"""A run scenario: one ROS 2 parameter file for the simulator and controller nodes.
+
+The file is an ordinary ``--params-file`` YAML::
+
+    sim_node:
+      ros__parameters:
+        sample_rate_hz: 1000.0   # [Hz]
+        duration: 20.0           # [s], 0 = until stopped
+        time_mode: lockstep      # lockstep | realtime
+        lockstep_timeout_s: 1.0  # [s] wall time to wait for a command
+        watchdog_samples: 50     # samples without a valid command -> V = 0
+        voltage_max: 10.0        # [V] commands beyond it are refused
+        theta0: 0.02             # [rad] initial angle, history of eq. (30)
+        track_limit: 0.4         # [m]
+        fallen_angle: 0.5236     # [rad]
+        cart_resolution: 4.54e-05    # [m] encoder count
+        angle_resolution: 0.0015340  # [rad] encoder count
+        plant: {M: ..., m: ..., l: ..., g: ..., alpha: ..., beta: ...}
+        friction: {model: exponential, eps: ..., ...}
+        plant_truth: {cogging_N: 0.0, ...}           # undeclared effects, rig.PlantTruth
+    controller_node:
+      ros__parameters:
+        sample_rate_hz: 1000.0
+        gain_source: yaml        # yaml | design
+        gain: [70.7107, 142.5409, 50.6911, 26.9817]
+        delay: 0.0               # [s] artificial feedback delay tau, eq. (26)
+        cutoff_hz: 20.0          # [Hz] velocity filter
+        voltage_limit: 10.0      # [V]
+        plant: {...}             # used when gain_source = design
+        design_friction: {...}
+        Q: [5000.0, 3000.0, 20.0, 20.0]
+        R: 1.0
+
+The same validation serves the offline tools and the nodes (which pass their own
+parameters, nested again, to :func:`scenario_from_ros_params`).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, fields
+from pathlib import Path
+from typing import Any, Mapping
+
+from ..physics.controller import StateFeedback, delay_samples
+from ..physics.encoder import ANGLE_RESOLUTION_RAD, CART_RESOLUTION_M
+from ..design.lqr import design
+from ..physics.params import (FRICTION_FIELDS, FRICTION_MODELS, PLANT_FIELDS, SMOOTHING, ConfigError, Field,
+                     FrictionParams, PlantParams, check_keys, check_number, check_choice, load_yaml)
+from ..physics.plant import CartPendulum
+from ..physics.rig import PlantTruth, Rig
+
+TIME_MODES = ('lockstep', 'realtime')
+GAIN_SOURCES = ('yaml', 'design')
+
+SIM_FIELDS = {
+    'sample_rate_hz': (1000.0, Field('Hz', 1.0, 1e5, 'sample rate of encoders and commands')),
+    'duration': (20.0, Field('s', 0.0, 1e6, 'simulated run length, 0 = until stopped')),
+    'lockstep_timeout_s': (1.0, Field('s', 0.0, 60.0, 'lockstep: wall time to wait for a command',
+                                      lo_open=True)),
+    'watchdog_samples': (50, Field('samples', 1, 1e6, 'samples without a valid command before V = 0',
+                                   integer=True)),
+    'voltage_max': (10.0, Field('V', 0.0, 1e3, 'largest accepted command', lo_open=True)),
+    'theta0': (0.02, Field('rad', -1.0, 1.0, 'initial angle from upright, eq. (30)')),
+    'track_limit': (0.4, Field('m', 0.0, 10.0, 'end the run beyond |x|', lo_open=True)),
+    'fallen_angle': (math.radians(30.0), Field('rad', 0.0, math.pi, 'end the run beyond |theta|',
+                                               lo_open=True)),
+    'cart_resolution': (CART_RESOLUTION_M, Field('m', 0.0, 1.0, 'cart encoder count (0 = exact)')),
+    'angle_resolution': (ANGLE_RESOLUTION_RAD, Field('rad', 0.0, 1.0, 'angle encoder count (0 = exact)')),
+}
+TRUTH_FIELDS = {
+    'cogging_N': Field('N', -100.0, 100.0, 'amplitude of the position-periodic force'),
+    'cogging_period_m': Field('m', 0.0, 10.0, 'period of the cogging force', lo_open=True),
+    'deadzone_V': Field('V', 0.0, 100.0, 'input deadzone'),
+    'saturation_V': Field('V', 0.0, 1e3, 'drive saturation (0 = none)'),
+    'input_delay_s': Field('s', 0.0, 10.0, 'transport delay of the command'),
+    'asymmetry_N': Field('N', -100.0, 100.0, 'extra Coulomb force forward (minus backward)'),
+    'backlash_m': Field('m', 0.0, 1.0, 'play between cart and its encoder'),
+    'bias_x_m': Field('m', -1.0, 1.0, 'cart sensor offset'),
+    'bias_theta_rad': Field('rad', -1.0, 1.0, 'angle sensor offset'),
+    'noise_x_m': Field('m', 0.0, 1.0, 'cart sensor noise (std)'),
+    'noise_theta_rad': Field('rad', 0.0, 1.0, 'angle sensor noise (std)'),
+    'noise_seed': Field('', 0, 2 ** 31 - 1, 'seed of the sensor noise', integer=True),
+}
+CONTROLLER_FIELDS = {
+    'sample_rate_hz': (1000.0, SIM_FIELDS['sample_rate_hz'][1]),
+    'delay': (0.0, Field('s', 0.0, 10.0, 'artificial feedback delay tau, eq. (26), a multiple of the sample period')),
+    'cutoff_hz': (20.0, Field('Hz', 0.0, 1e4, 'velocity filter corner (0 = raw difference)')),
+    'voltage_limit': (10.0, Field('V', 0.0, 1e3, 'command saturation', lo_open=True)),
+    'R': (1.0, Field('', 0.0, 1e12, 'LQR control weight', lo_open=True)),
+}
+DEFAULT_Q = [5000.0, 3000.0, 20.0, 20.0]
+WEIGHT = Field('', 0.0, 1e12, 'LQR state weight')
+GAIN = Field('V per SI unit', -1e6, 1e6, 'state feedback gain')
+
+
+@dataclass(frozen=True)
+class SimSettings:
+    sample_rate_hz: float = 1000.0
+    duration: float = 20.0
+    time_mode: str = 'lockstep'
+    lockstep_timeout_s: float = 1.0
+    watchdog_samples: int = 50
+    voltage_max: float = 10.0
+    theta0: float = 0.02
+    track_limit: float = 0.4
+    fallen_angle: float = math.radians(30.0)
+    cart_resolution: float = CART_RESOLUTION_M
+    angle_resolution: float = ANGLE_RESOLUTION_RAD
+
+
+@dataclass(frozen=True)
+class ControllerSettings:
+    sample_rate_hz: float = 1000.0
+    gain_source: str = 'yaml'
+    gain: tuple | None = None
+    delay: float = 0.0
+    cutoff_hz: float = 20.0
+    voltage_limit: float = 10.0
+    plant: PlantParams = PlantParams()
+    design_friction: FrictionParams | None = None
+    Q: tuple = tuple(DEFAULT_Q)
+    R: float = 1.0
+
+
+def _gain(path: str, value: Any) -> tuple:
+    if not isinstance(value, (list, tuple)) or len(value) not in (4, 5):
+        raise ConfigError(f'{path}: expected 4 numbers (x, theta, x\', theta\') [V/m, V/rad, V s/m, V s/rad], '
+                          f'got {value!r}')
+    g = tuple(check_number(f'{path}[{i}]', v, GAIN) for i, v in enumerate(value))
+    if len(g) == 5 and g[4] != 0.0:
+        raise ConfigError(f'{path}[4]: the bristle state z is not measured; its gain must be 0')
+    return g[:4]
+
+
+def parse_sim(data: Mapping, path: str = 'sim_node.ros__parameters'):
+    """(SimSettings, PlantParams, FrictionParams, PlantTruth) from a nested mapping."""
+    known = set(SIM_FIELDS) | {'time_mode', 'plant', 'friction', 'plant_truth', 'use_sim_time'}
+    data = check_keys(path, data, known, {'plant', 'friction'})
+    values = {k: check_number(f'{path}.{k}', data[k], spec) for k, (_, spec) in SIM_FIELDS.items() if k in data}
+    if 'watchdog_samples' in values:
+        values['watchdog_samples'] = int(values['watchdog_samples'])
+    values['time_mode'] = check_choice(f'{path}.time_mode', data.get('time_mode', 'lockstep'), TIME_MODES)
+    sim = SimSettings(**values)
+    plant = PlantParams.from_dict(data['plant'], f'{path}.plant')
+    friction = FrictionParams.from_dict(data['friction'], f'{path}.friction')
+    tdata = check_keys(f'{path}.plant_truth', data.get('plant_truth', {}) or {}, set(TRUTH_FIELDS), set())
+    tvals = {k: check_number(f'{path}.plant_truth.{k}', tdata[k], s) for k, s in TRUTH_FIELDS.items() if k in tdata}
+    if 'noise_seed' in tvals:
+        tvals['noise_seed'] = int(tvals['noise_seed'])
+    truth = PlantTruth(**tvals)
+    dt = 1.0 / sim.sample_rate_hz
+    try:
+        delay_samples(truth.input_delay_s, dt)
+    except ValueError as exc:
+        raise ConfigError(f'{path}.plant_truth.input_delay_s: {exc}') from exc
+    return sim, plant, friction, truth
+
+
+def parse_controller(data: Mapping, path: str = 'controller_node.ros__parameters') -> ControllerSettings:
+    known = set(CONTROLLER_FIELDS) | {'gain_source', 'gain', 'plant', 'design_friction', 'Q', 'use_sim_time'}
+    data = check_keys(path, data, known, set())
+    values = {k: check_number(f'{path}.{k}', data[k], spec)
+              for k, (_, spec) in CONTROLLER_FIELDS.items() if k in data}
+    source = check_choice(f'{path}.gain_source', data.get('gain_source', 'yaml'), GAIN_SOURCES)
+    gain = design_friction = None
+    plant = PlantParams.from_dict(data['plant'], f'{path}.plant') if 'plant' in data else PlantParams()
+    if source == 'yaml':
+        if 'gain' not in data:
+            raise ConfigError(f'{path}.gain: missing; gain_source yaml needs 4 gains')
+        gain = _gain(f'{path}.gain', data['gain'])
+    else:
+        if 'design_friction' not in data:
+            raise ConfigError(f'{path}.design_friction: missing; gain_source design needs a friction model '
+                              f'({", ".join(FRICTION_MODELS)})')
+        design_friction = FrictionParams.from_dict(data['design_friction'], f'{path}.design_friction')
+    Q = data.get('Q', DEFAULT_Q)
+    if not isinstance(Q, (list, tuple)) or len(Q) != 4:
+        raise ConfigError(f'{path}.Q: expected 4 weights on (x, theta, x\', theta\'), got {Q!r}')
+    Q = tuple(check_number(f'{path}.Q[{i}]', q, WEIGHT) for i, q in enumerate(Q))
+    settings = ControllerSettings(gain_source=source, gain=gain, plant=plant, design_friction=design_friction,
+                                  Q=Q, **values)
+    try:
+        delay_samples(settings.delay, 1.0 / settings.sample_rate_hz)
+    except ValueError as exc:
+        raise ConfigError(f'{path}.delay: {exc}') from exc
+    return settings
+
+
+@dataclass(frozen=True)
+class Scenario:
+    sim: SimSettings
+    plant: PlantParams
+    friction: FrictionParams
+    truth: PlantTruth
+    controller: ControllerSettings
+
+    @property
+    def sample_period(self) -> float:
+        return 1.0 / self.sim.sample_rate_hz
+
+    def gain(self) -> list:
+        """The gain the controller applies: from YAML, or designed on ``design_friction``."""
+        c = self.controller
+        if c.gain is not None:
+            return list(c.gain)
+        return design(c.plant, c.design_friction, c.Q, c.R).gain[:4].tolist()
+
+    def make_rig(self) -> Rig:
+        s = self.sim
+        return Rig(CartPendulum(self.plant, self.friction), self.truth, [0.0, s.theta0, 0.0, 0.0],
+                   self.sample_period, (s.cart_resolution, s.angle_resolution), s.track_limit, s.fallen_angle)
+
+    def make_controller(self) -> StateFeedback:
+        c = self.controller
+        return StateFeedback(self.gain(), 1.0 / c.sample_rate_hz, c.delay, c.cutoff_hz, c.voltage_limit)
+
+    def to_dict(self) -> dict:
+        """The full configuration, JSON/YAML-ready, with the gain actually used."""
+        c = self.controller
+        ctrl = {k: v for k, v in asdict(c).items() if k not in ('plant', 'design_friction', 'gain', 'Q')}
+        ctrl.update(gain=list(c.gain) if c.gain else None, Q=list(c.Q),
+                    plant=asdict(c.plant),
+                    design_friction=c.design_friction.to_dict() if c.design_friction else None)
+        return {'sim': asdict(self.sim), 'plant': asdict(self.plant), 'friction': self.friction.to_dict(),
+                'plant_truth': self.truth.to_dict(), 'controller': ctrl, 'gain': self.gain()}
+
+    def to_ros_params(self) -> dict:
+        """The scenario as a ``--params-file`` mapping (inverse of :func:`load_scenario`)."""
+        c = self.controller
+        sim = {**asdict(self.sim), 'plant': asdict(self.plant), 'friction': self.friction.to_dict(),
+               'plant_truth': self.truth.to_dict()}
+        ctrl = {'sample_rate_hz': c.sample_rate_hz, 'gain_source': c.gain_source, 'delay': c.delay,
+                'cutoff_hz': c.cutoff_hz, 'voltage_limit': c.voltage_limit, 'plant': asdict(c.plant),
+                'Q': list(c.Q), 'R': c.R}
+        if c.gain is not None:
+            ctrl['gain'] = list(c.gain)
+        if c.design_friction is not None:
+            ctrl['design_friction'] = c.design_friction.to_dict()
+        return {'sim_node': {'ros__parameters': sim}, 'controller_node': {'ros__parameters': ctrl}}
+
+    @staticmethod
+    def flat_defaults(node: str) -> dict:
+        """Every ROS parameter of ``node`` as name -> (default, description, (lo, hi) or None)."""
+        out: dict = {}
+
+        def num(name, default, spec: Field):
+            out[name] = (default, f'{spec.doc} [{spec.unit}]' if spec.unit else spec.doc, (spec.lo, spec.hi))
+
+        def friction(prefix, fp: FrictionParams):
+            out[f'{prefix}.model'] = (fp.model, 'friction model: ' + ' | '.join(FRICTION_MODELS), None)
+            out[f'{prefix}.smoothing'] = (fp.smoothing, 'sgn(v) smoothing: ' + ' | '.join(SMOOTHING), None)
+            for k, spec in FRICTION_FIELDS.items():
+                num(f'{prefix}.{k}', getattr(fp, k), spec)
+
+        def plant(prefix):
+            for k, spec in PLANT_FIELDS.items():
+                num(f'{prefix}.{k}', getattr(PlantParams(), k), spec)
+
+        if node == 'sim_node':
+            for k, (default, spec) in SIM_FIELDS.items():
+                num(k, default, spec)
+            out['time_mode'] = ('lockstep', 'lockstep | realtime', None)
+            plant('plant')
+            friction('friction', FrictionParams())
+            for f in fields(PlantTruth):
+                num(f'plant_truth.{f.name}', f.default, TRUTH_FIELDS[f.name])
+        elif node == 'controller_node':
+            for k, (default, spec) in CONTROLLER_FIELDS.items():
+                num(k, default, spec)
+            out['gain_source'] = ('yaml', 'where the gain comes from: yaml | design', None)
+            out['gain'] = ([0.0, 0.0, 0.0, 0.0], 'V = K (x, theta, x\', theta\') [V/m, V/rad, V s/m, V s/rad]', None)
+            out['Q'] = (list(DEFAULT_Q), 'LQR weights on (x, theta, x\', theta\')', None)
+            plant('plant')
+            friction('design_friction', FrictionParams())
+        else:
+            raise ConfigError(f'node: {node!r} is not one of sim_node, controller_node')
+        return out
+
+
+def nest(flat: Mapping[str, Any]) -> dict:
+    """{'a.b': 1} -> {'a': {'b': 1}} (ROS parameter names to the YAML nesting)."""
+    out: dict = {}
+    for key, value in flat.items():
+        node = out
+        parts = key.split('.')
+        for p in parts[:-1]:
+            node = node.setdefault(p, {})
+        node[parts[-1]] = value
+    return out
+
+
+def scenario_from_ros_params(sim_params: Mapping | None, controller_params: Mapping | None) -> Scenario:
+    """Validate the two nodes' (nested) parameters; either may be None (a node needs one)."""
+    if sim_params is not None:
+        sim, plant, friction, truth = parse_sim(sim_params)
+    else:
+        sim, plant, friction, truth = SimSettings(), PlantParams(), FrictionParams(), PlantTruth()
+    ctrl = parse_controller(controller_params) if controller_params is not None else ControllerSettings(
+        gain=(0.0, 0.0, 0.0, 0.0))
+    return Scenario(sim, plant, friction, truth, ctrl)
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Load a scenario parameter file (both node sections required)."""
+    data = load_yaml(path)
+    sections = {}
+    for node in ('sim_node', 'controller_node'):
+        if node not in data:
+            raise ConfigError(f'{path}: missing section {node}: ros__parameters:')
+        sec = data[node]
+        if not isinstance(sec, Mapping) or 'ros__parameters' not in sec:
+            raise ConfigError(f'{path}: {node}: expected a mapping with ros__parameters')
+        sections[node] = sec['ros__parameters']
+    unknown = set(data) - {'sim_node', 'controller_node', 'recorder'}
+    if unknown:
+        raise ConfigError(f'{path}: unknown section(s) {", ".join(sorted(unknown))}; allowed: '
+                          f'sim_node, controller_node, recorder')
+    return scenario_from_ros_params(sections['sim_node'], sections['controller_node'])

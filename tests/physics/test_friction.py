@@ -1,0 +1,65 @@
+import math
+
+import pytest
+
+from ipfric_core.physics.friction import Friction, static_friction, stribeck_level
+from ipfric_core.physics.params import FrictionParams
+
+FN = (0.815 + 0.21) * 9.8
+EXP = FrictionParams('exponential', eps=3.0, mu_s=0.0861, mu_c=0.04287, v_s=0.105, gamma=2.0)
+DYN = FrictionParams('dynamic', eps=3.0, mu_s=0.0861, mu_c=0.04287, v_s=0.105, gamma=2.0,
+                     sigma0=121.0, sigma1=70.0)
+
+
+def test_viscous_eq3():
+    f = Friction(FrictionParams('viscous', eps=2.1), FN)
+    assert f.force(0.2) == pytest.approx(-0.42)
+    assert not f.sticks and f.static_limit == 0.0
+
+
+def test_coulomb_viscous_eqs_6_7():
+    f = Friction(FrictionParams('coulomb', eps=2.3156, mu_s=0.08328, mu_c=0.04287), FN)
+    assert f.force(0.1) == pytest.approx(-0.04287 * FN - 0.23156)
+    assert f.force(-0.1) == pytest.approx(0.04287 * FN + 0.23156)
+    assert f.sticks and f.static_limit == pytest.approx(0.08328 * FN)
+
+
+def test_static_eq5():
+    lim = 0.0861 * FN
+    assert static_friction(0.5, lim) == -0.5
+    assert static_friction(-2.0, lim) == pytest.approx(lim)
+    f = Friction(EXP, FN)
+    assert f.holds(0.99 * lim) and not f.holds(1.01 * lim)
+
+
+def test_stribeck_eq8_limits():
+    f = Friction(EXP, FN)
+    assert f.level(0.0) == pytest.approx(0.0861 * FN)            # static level at rest
+    assert f.level(10.0) == pytest.approx(0.04287 * FN)          # Coulomb level when fast
+    v = 0.105                                                     # at v_s: exp(-1)
+    assert stribeck_level(v, 0.0861, 0.04287, 0.105, 2.0, FN) == pytest.approx(
+        (0.04287 + (0.0861 - 0.04287) / math.e) * FN)
+    assert f.force(0.05) == pytest.approx(-f.level(0.05) - 0.15)
+    assert f.force(0.0, direction=-1.0) == pytest.approx(0.0861 * FN)
+
+
+def test_tanh_smoothing_and_linear_slope():
+    f = Friction(EXP.replace(smoothing='tanh', delta=100.0), FN)
+    assert not f.sticks
+    assert f.force(1e-6) == pytest.approx(-(3.0 + 100 * 0.0861 * FN) * 1e-6, rel=1e-6)
+    assert f.slope_at_rest() == pytest.approx(3.0 + 100 * 0.0861 * FN)
+
+
+def test_dynamic_steady_state_equals_exponential():
+    """Section 2.2: at constant v, z -> g(v) sgn(v)/sigma0 and F -> eq. (8)."""
+    f = Friction(DYN, FN)
+    for v in (0.02, 0.1, -0.3):
+        z = f.level(v) * math.copysign(1, v) / 121.0
+        assert f.z_rate(v, z) == pytest.approx(0.0, abs=1e-12)
+        assert f.force(v, z) == pytest.approx(Friction(EXP, FN).force(v), rel=1e-12)
+
+
+def test_dynamic_presliding_is_a_spring():
+    f = Friction(DYN, FN)
+    assert f.force(0.0, 1e-3) == pytest.approx(-0.121)
+    assert f.z_rate(1e-3, 0.0) == pytest.approx(1e-3)
