@@ -63,3 +63,14 @@ def test_dynamic_presliding_is_a_spring():
     f = Friction(DYN, FN)
     assert f.force(0.0, 1e-3) == pytest.approx(-0.121)
     assert f.z_rate(1e-3, 0.0) == pytest.approx(1e-3)
+
+
+def test_asymmetric_static_limits_and_sliding_levels():
+    """a = 0.5: static friction holds up to 1.5 mu_s F_N forward and 0.5 mu_s F_N backward;
+    sliding levels (1 +/- a) g(v); dF_v adds to eps forward and subtracts backward."""
+    p = FrictionParams(model='coulomb', eps=1.0, mu_s=0.1, mu_c=0.05, asymmetry=0.5, asymmetry_viscous=0.4)
+    f = Friction(p, 10.0)
+    assert f.holds(1.49) and not f.holds(1.51)
+    assert f.holds(-0.49) and not f.holds(-0.51)
+    assert f.force(0.5) == pytest.approx(-1.5 * 0.5 - (1.0 + 0.4) * 0.5)
+    assert f.force(-0.5) == pytest.approx(0.5 * 0.5 + (1.0 - 0.4) * 0.5)

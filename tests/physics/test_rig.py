@@ -51,7 +51,7 @@ def test_cogging_force_moves_a_resting_cart():
 def test_asymmetry_brakes_forward_motion_more():
     ends = {}
     for a in (0.0, 0.2):
-        r = rig(PlantTruth(asymmetry_N=a))
+        r = rig(PlantTruth(asymmetry=a))
         for _ in range(300):
             r.step(2.0)
         ends[a] = r.truth()['x']

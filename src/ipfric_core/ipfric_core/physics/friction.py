@@ -12,6 +12,12 @@ Models (``FrictionParams.model``):
                    z' = v - sigma0 |v| z / g(v)                           eqs. (10)-(11)
 
 with the Stribeck level g(v) = (mu_c + (mu_s - mu_c) exp(-(|v|/v_s)^gamma)) F_N.
+
+Direction dependence (``asymmetry`` a, ``asymmetry_viscous`` dF_v; both 0 in the paper):
+the level is (1 + a) g forward and (1 - a) g backward, static friction included, and the
+viscous coefficient eps + dF_v forward, eps - dF_v backward: F gains -a g(v) - dF_v |v| while
+sliding, and static friction holds -(1 - a) mu_s F_N < F_applied < (1 + a) mu_s F_N. (The dynamic law keeps
+the symmetric bristle model and takes only dF_v.)
 With ``smoothing='tanh'`` sgn(v) becomes tanh(delta v) and the law is smooth (no
 sticking phase). Sticking itself (the cart at rest while the force static friction
 must cancel stays below mu_s F_N) is a property of the motion, handled by
@@ -34,18 +40,19 @@ from .params import FrictionParams
 MODEL_CODES = {'viscous': 0.0, 'coulomb': 1.0, 'exponential': 2.0, 'dynamic': 3.0}
 VISCOUS, COULOMB, EXPONENTIAL, DYNAMIC = 0.0, 1.0, 2.0, 3.0
 # Positions in the parameter vector of :func:`parameter_vector`.
-MODEL, SMOOTH, EPS, MU_S, MU_C, V_S, GAMMA, SIGMA0, SIGMA1, DELTA, FN = range(11)
+MODEL, SMOOTH, EPS, MU_S, MU_C, V_S, GAMMA, SIGMA0, SIGMA1, DELTA, FN, ASYM, ASYM_V = range(13)
 
 
 def parameter_vector(params: FrictionParams, normal_force: float) -> tuple:
-    """The law as a tuple of 11 floats, the argument ``fp`` of the scalar functions below.
+    """The law as a tuple of 13 floats, the argument ``fp`` of the scalar functions below.
 
-    (model code, tanh smoothing 0/1, eps, mu_s, mu_c, v_s, gamma, sigma0, sigma1, delta, F_N).
+    (model code, tanh smoothing 0/1, eps, mu_s, mu_c, v_s, gamma, sigma0, sigma1, delta, F_N,
+    asymmetry a, asymmetry_viscous dF_v).
     """
     p = params
     return (MODEL_CODES[p.model], 1.0 if p.smoothing == 'tanh' else 0.0, float(p.eps), float(p.mu_s),
             float(p.mu_c), float(p.v_s), float(p.gamma), float(p.sigma0), float(p.sigma1), float(p.delta),
-            float(normal_force))
+            float(normal_force), float(p.asymmetry), float(p.asymmetry_viscous))
 
 
 @compiled
@@ -77,9 +84,17 @@ def static_limit(fp) -> float:
 
 
 @compiled
+def holding_margin(fp, applied: float) -> float:
+    """|F_applied - a mu_s F_N| - mu_s F_N [N]: negative while static friction holds (eq. 5 with
+    the direction-dependent limits -(1 - a) mu_s F_N and (1 + a) mu_s F_N)."""
+    lim = static_limit(fp)
+    return abs(applied - fp[ASYM] * lim) - lim
+
+
+@compiled
 def holds(fp, applied: float) -> bool:
     """True when static friction can hold the resting cart against ``applied`` [N] (eq. 5)."""
-    return abs(applied) < static_limit(fp)
+    return holding_margin(fp, applied) < 0.0
 
 
 @compiled
@@ -100,17 +115,18 @@ def friction_force(fp, v: float, z: float, direction: float) -> float:
     ends exactly at v = 0 keeps the sign of the motion it integrates; 0 = use sgn(v).
     """
     model = fp[MODEL]
+    viscous = -fp[EPS] * v - fp[ASYM_V] * abs(v)
     if model == VISCOUS:
-        return -fp[EPS] * v
+        return viscous
     if model == DYNAMIC:
-        return -(fp[SIGMA1] + fp[EPS]) * v - fp[SIGMA0] * z * (1.0 - fp[SIGMA1] * abs(v) / sliding_level(fp, v))
+        return viscous - fp[SIGMA1] * v - fp[SIGMA0] * z * (1.0 - fp[SIGMA1] * abs(v) / sliding_level(fp, v))
     if fp[SMOOTH] != 0.0:
         sign = math.tanh(fp[DELTA] * v)
     elif direction != 0.0:
         sign = direction
     else:
         sign = math.copysign(1.0, v) if v != 0.0 else 0.0
-    return -sliding_level(fp, v) * sign - fp[EPS] * v
+    return -sliding_level(fp, v) * (sign + fp[ASYM]) + viscous
 
 
 @compiled

@@ -113,6 +113,9 @@ FRICTION_FIELDS = {
     'sigma0': Field('N/m', 0.0, 1e9, 'bristle stiffness, eq. (10)', lo_open=True),
     'sigma1': Field('N s/m', 0.0, 1e6, 'bristle damping, eq. (11)'),
     'delta': Field('s/m', 0.0, 1e6, 'slope of the tanh(delta v) smoothing of sgn(v)', lo_open=True),
+    'asymmetry': Field('', -0.9, 0.9, 'friction level (1 + a) forward, (1 - a) backward, static included'),
+    'asymmetry_viscous': Field('N s/m', -1e3, 1e3, 'viscous term eps v + dF_v |v|: eps + dF_v forward, '
+                               'eps - dF_v backward'),
 }
 # Fields each model needs (besides 'model' and 'smoothing').
 FRICTION_REQUIRED = {
@@ -142,6 +145,8 @@ class FrictionParams:
     sigma1: float = 70.0
     smoothing: str = 'none'
     delta: float = 100.0
+    asymmetry: float = 0.0
+    asymmetry_viscous: float = 0.0
 
     @classmethod
     def from_dict(cls, data: Any, path: str = 'friction') -> 'FrictionParams':
@@ -166,6 +171,7 @@ class FrictionParams:
         keep = FRICTION_REQUIRED[self.model] | {'model'}
         if self.model in ('coulomb', 'exponential'):
             keep |= {'smoothing', 'delta'}
+        keep |= {k for k in ('asymmetry', 'asymmetry_viscous') if getattr(self, k)}
         return {k: v for k, v in asdict(self).items() if k in keep}
 
     def replace(self, **changes) -> 'FrictionParams':

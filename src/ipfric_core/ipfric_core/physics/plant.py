@@ -64,19 +64,17 @@ def stuck_theta_acceleration(pp, theta: float) -> float:
 
 @compiled
 def undeclared_force(ef, x: float, v: float) -> float:
-    """Force on the cart [N] from effects the friction model does not declare.
+    """Force on the cart [N] fixed to the track, that the friction model does not declare.
 
-    ``ef`` = (cogging amplitude [N], cogging period [m], asymmetry [N]): a position-periodic
-    cogging force A sin(2 pi x / P), and a constant -asymmetry while the cart moves (the
-    Coulomb level raised forward, lowered backward). (0, 1, 0) = none.
+    ``ef`` = (cogging amplitude A [N], cogging period P [m], cogging phase phi [rad], offset
+    F0 [N]): A sin(2 pi x / P + phi) + F0 (motor cogging, screw ripple; a sloped track or an
+    amplifier offset). It acts at rest too. ``v`` is unused (the signature of a force law).
     """
-    f = ef[0] * math.sin(2 * math.pi * x / ef[1]) if ef[0] != 0.0 else 0.0
-    if v != 0.0:
-        f -= ef[2]
-    return f
+    f = ef[0] * math.sin(2 * math.pi * x / ef[1] + ef[2]) if ef[0] != 0.0 else 0.0
+    return f + ef[3]
 
 
-NO_EXTRA_FORCE = (0.0, 1.0, 0.0)
+NO_EXTRA_FORCE = (0.0, 1.0, 0.0, 0.0)
 
 
 @compiled

@@ -17,6 +17,7 @@ import numpy as np
 
 from .compiled import compiled
 from .encoder import quantize
+from .params import FrictionParams
 from .plant import CartPendulum
 from .simulate import Simulator
 
@@ -25,11 +26,14 @@ from .simulate import Simulator
 class PlantTruth:
     """Undeclared effects (all 0 = off).
 
-    cogging_N, cogging_period_m : position-periodic force A sin(2 pi x / P) [N], [m]
+    cogging_N, cogging_period_m, cogging_phase_rad : position-periodic force
+        A sin(2 pi x / P + phi) [N], [m], [rad]
+    offset_N : constant force on the cart (a sloped track, an amplifier offset) [N]
+    asymmetry : friction level (1 + a) forward, (1 - a) backward, static friction included
+    asymmetry_viscous_Ns_per_m : viscous coefficient eps + dF_v forward, eps - dF_v backward
     deadzone_V : input deadzone; |V| below it gives no force, above it V - sgn(V) dz [V]
     saturation_V : the drive cannot apply more than this [V] (0 = no limit)
     input_delay_s : transport delay of the command [s], a multiple of the sample period
-    asymmetry_N : Coulomb level + asymmetry forward, - asymmetry backward [N]
     backlash_m : play between cart and its position encoder (rack and pinion) [m]
     bias_x_m, bias_theta_rad : constant sensor offsets [m], [rad]
     noise_x_m, noise_theta_rad : standard deviation of Gaussian sensor noise [m], [rad]
@@ -38,10 +42,13 @@ class PlantTruth:
 
     cogging_N: float = 0.0
     cogging_period_m: float = 0.01
+    cogging_phase_rad: float = 0.0
+    offset_N: float = 0.0
+    asymmetry: float = 0.0
+    asymmetry_viscous_Ns_per_m: float = 0.0
     deadzone_V: float = 0.0
     saturation_V: float = 0.0
     input_delay_s: float = 0.0
-    asymmetry_N: float = 0.0
     backlash_m: float = 0.0
     bias_x_m: float = 0.0
     bias_theta_rad: float = 0.0
@@ -53,8 +60,16 @@ class PlantTruth:
         return asdict(self)
 
     def force_vector(self) -> tuple:
-        """The forces on the cart as ``plant.undeclared_force`` takes them."""
-        return (float(self.cogging_N), float(self.cogging_period_m), float(self.asymmetry_N))
+        """The forces fixed to the track as ``plant.undeclared_force`` takes them."""
+        return (float(self.cogging_N), float(self.cogging_period_m), float(self.cogging_phase_rad),
+                float(self.offset_N))
+
+    def true_friction(self, friction: FrictionParams) -> FrictionParams:
+        """The declared friction law with the rig's direction dependence added."""
+        if not (self.asymmetry or self.asymmetry_viscous_Ns_per_m):
+            return friction
+        return friction.replace(asymmetry=friction.asymmetry + self.asymmetry,
+                                asymmetry_viscous=friction.asymmetry_viscous + self.asymmetry_viscous_Ns_per_m)
 
 
 @compiled
@@ -122,6 +137,9 @@ class Rig:
         self.resolution = resolution
         self.track_limit = track_limit
         self.fallen_angle = fallen_angle
+        friction = truth.true_friction(model.friction.params)
+        if friction is not model.friction.params:
+            model = CartPendulum(model.p, friction, model.friction.normal_force)
         self.sim = Simulator(model, state0, extra_force=truth.force_vector())
         n = round(truth.input_delay_s / dt)
         self._pending = deque([0.0] * n)

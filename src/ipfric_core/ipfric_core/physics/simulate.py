@@ -25,7 +25,7 @@ import math
 
 
 from .compiled import compiled
-from .friction import friction_force, holds, static_limit, sticks
+from .friction import friction_force, holding_margin, holds, sticks
 from .plant import (NO_EXTRA_FORCE, CartPendulum, held_force, motor_force, rates,
                     stuck_theta_acceleration, undeclared_force)
 
@@ -75,11 +75,11 @@ def held(pp, ef, s, voltage):
 def _event(kind, pp, fp, ef, s, tau, voltage, d, level):
     """Event functions of the step length tau [s], each changing sign at the event.
 
-    kind 0 (breakaway): |held force| - mu_s F_N after tau stuck; kind 1 (stop): x' d after
-    tau sliding, with ``level`` = |x'| at tau = 0.
+    kind 0 (breakaway): the holding margin of the held force after tau stuck; kind 1 (stop):
+    x' d after tau sliding, with ``level`` = |x'| at tau = 0.
     """
     if kind == 0:
-        return abs(held(pp, ef, rk4_stuck(pp, s, tau), voltage)) - level
+        return holding_margin(fp, held(pp, ef, rk4_stuck(pp, s, tau), voltage))
     if tau <= 0.0:
         return level
     return rk4_slide(pp, fp, ef, s, tau, voltage, d)[2] * d
@@ -141,7 +141,6 @@ def _settle(pp, fp, ef, s, voltage, events):
 @compiled
 def _advance_hybrid(pp, fp, ef, s, mode, h, voltage):
     stuck, d, events = mode
-    lim = static_limit(fp)
     remaining = h
     for _ in range(MAX_EVENTS):
         if remaining <= 0.0:
@@ -154,7 +153,7 @@ def _advance_hybrid(pp, fp, ef, s, mode, h, voltage):
             new = rk4_stuck(pp, s, remaining)
             if holds(fp, held(pp, ef, new, voltage)):
                 return new, (stuck, d, events)
-            tb = _locate(0, pp, fp, ef, s, remaining, voltage, 0.0, lim)
+            tb = _locate(0, pp, fp, ef, s, remaining, voltage, 0.0, 0.0)
             tb = min(remaining, tb * (1 + 1e-9) + 1e-15)  # step just past the threshold
             s = rk4_stuck(pp, s, tb)
             remaining -= tb
