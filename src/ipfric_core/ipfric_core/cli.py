@@ -326,7 +326,7 @@ def cmd_identify(args) -> int:
               f'{b["x_p2p_m"] * 1000:.2f} mm, angle p2p {math.degrees(b["theta_p2p_rad"]):.3f} deg')
         idf = out['identified']
         print(f'identified: {idf["base_model"]} + {", ".join(idf["effects_added"]) or "nothing"}; '
-              + ', '.join(f'{k} {v:.4g}' for k, v in idf['friction'].items()))
+              + ', '.join(f'{k} {v:.4g}' for k, v in idf['friction'].items() if not isinstance(v, str)))
         print(f'redesigned gain {[round(k, 2) for k in out["gain_after"]]} -> {a["class"]}, cart p2p '
               f'{a["x_p2p_m"] * 1000:.2f} mm, angle p2p {math.degrees(a["theta_p2p_rad"]):.3f} deg')
         print(f'cart amplitude {b["x_p2p_m"] * 1000:.2f} mm before, {a["x_p2p_m"] * 1000:.2f} mm after; '
@@ -338,10 +338,13 @@ def cmd_identify(args) -> int:
         from .run.scenario import load_scenario
         plant = load_scenario(args.plant).plant
     elif args.plant:
-        plant = load_paper_config(args.plant).plant
+        data = load_yaml(args.plant)
+        if 'plant' not in data:
+            raise ConfigError(f'{args.plant}: no plant: section (a scenario has sim_node:, a plant file plant:)')
+        plant = PlantParams.from_dict(data['plant'], f'{args.plant}: plant')
     if args.data == 'paper':
         from .design.estimation import load_table5, load_table6
-        from .ident.identify import identify_steady
+        from .ident.equation_error import identify_steady
         d = Path(args.tables)
         V, v, _, _, aside = load_table5(d / 'table5_constant_voltage.csv')
         rep = identify_steady(plant or PlantParams(), V, v, load_table6(d / 'table6_breakaway_voltage.csv'))
@@ -357,8 +360,6 @@ def cmd_identify(args) -> int:
               f'{rep["residual_curvature_N"]:+.4f} N')
         return 0
     from .ident.records import load
-    from .ident.identify import identify
-    from .ident.report import write_report
     columns = {}
     for item in args.columns.split(',') if args.columns else []:
         key, _, name = item.partition('=')
@@ -378,14 +379,54 @@ def cmd_identify(args) -> int:
         if not 0.2 <= args.split <= 0.9:
             raise ConfigError(f'--split: {args.split:g} is out of range; allowed [0.2, 0.9]')
         est, val = rec.split(args.split)
-    if args.base not in BASE_MODELS:
-        raise ConfigError(f'--base: {args.base!r} is not one of {", ".join(BASE_MODELS)}')
-    r = write_report(identify(est, val, args.base, allowed), args.out, not args.no_plots)
+    if Path(args.data).suffix.lower() == '.mat':
+        return _identify_force_input(args, est, val, allowed)
+    from .ident.ladder import run_ladder
+    from .ident.ladder_report import write_ladder_report
+    from .ident.model import load_declared
+    model = load_declared(args.plant, args.base, rec.theta is not None, plant)
+    if args.free:
+        model = model.freeing([n.strip() for n in args.free.split(',')])
+    say = None if args.json else (lambda msg: print(msg, file=sys.stderr))
+    r = write_ladder_report(run_ladder(est, val, model, allowed, say), args.out, not args.no_plots)
     if args.export:
         from .ident.redesign import export_scenario
         from .run.scenario import load_scenario
-        r['export'] = export_scenario(args.export, r, load_scenario(args.scenario),
+        idf = r['identified']
+        r['export'] = export_scenario(args.export, r['ladder'][-1]['step'], idf, load_scenario(args.scenario),
                                       load_scenario(args.rig) if args.rig else None)
+    if args.json:
+        _print_json(r)
+        return 0
+    print(f'{r["data"]["estimation"]} / {r["data"]["validation"]}: effects added: '
+          f'{", ".join(r["effects_added"]) or "none"}')
+    for note in r['data']['notes']:
+        print(f'  data: {note}')
+    for s in r['ladder']:
+        v = s['validation']
+        print(f'  {s["step"]:<14} validation simulation error {v["x_rms_counts"]:8.3g} counts ({v["x_percent"]:.3g} %)'
+              + (f', angle {v["theta_rms_counts"]:.3g} counts' if 'theta_rms_counts' in v else ''))
+        for n in s['notes']:
+            print(f'    {n}')
+    last = r['ladder'][-1]
+    print('  ' + ', '.join(f'{p["name"]} {_fmt_param(p)}' for p in last['params'] if p['fitted']))
+    print(f'  report {Path(args.out) / "report.md"}')
+    if args.export:
+        print(f'  exported {r["export"]["scenario"]}' + (f' and {r["export"]["on_rig"]}' if args.rig else ''))
+    return 0
+
+
+def _fmt_param(p: dict) -> str:
+    std = f' +/- {p["std"]:.2g}' if p['std'] is not None and math.isfinite(p['std']) else ''
+    return f'{p["value"]:.4g}{std} {p["unit"]}'.rstrip()
+
+
+def _identify_force_input(args, est, val, allowed) -> int:
+    """A force-input record without a declared plant (EMPS): the equation-error search, with the
+    simulation error of its result beside the force error."""
+    from .ident.equation_error import identify
+    from .ident.report import write_report
+    r = write_report(identify(est, val, args.base, allowed), args.out, not args.no_plots)
     if args.json:
         _print_json(r)
         return 0
@@ -396,14 +437,13 @@ def cmd_identify(args) -> int:
         print(f'  {tag.replace("_", " "):<13} estimation {e["estimation"]["relative_percent"]:.3f} % '
               f'(RMS {e["estimation"]["rms"]:.4g} N), validation {e["validation"]["relative_percent"]:.3f} % '
               f'(RMS {e["validation"]["rms"]:.4g} N)')
+    sim = r['simulation_error']
+    print(f'  simulation error (validation): {sim["x_rms_counts"]:.3g} counts, {sim["x_percent"]:.3g} % of the motion')
     for t in r['effects_tried']:
         print(f'  tried {t["name"]:<11} validation gain {t["validation_gain_percent"]:7.2f} %  '
               f'p {t["validation_p"]:.2g}  {"kept" if t["kept"] else "rejected"}')
     print('  ' + ', '.join(f'{k} {p["value"]:.5g} +/- {p["std"]:.2g} {p["unit"]}' for k, p in r['params'].items()))
-    print(f'  residual white: before {r["residual_white_before"]}, after {r["residual_white_after"]}; '
-          f'report {Path(args.out) / "report.md"}')
-    if args.export:
-        print(f'  exported {r["export"]["scenario"]}' + (f' and {r["export"]["on_rig"]}' if args.rig else ''))
+    print(f'  report {Path(args.out) / "report.md"}')
     return 0
 
 
@@ -495,11 +535,14 @@ def build_parser() -> argparse.ArgumentParser:
     i.add_argument('--validation', help='second file for validation (default: the last part of DATA)')
     i.add_argument('--split', type=float, default=0.6, help='estimation share of DATA when no --validation '
                    '(default %(default)s)')
-    i.add_argument('--base', default='viscous', help='declared base model: viscous, coulomb, exponential, '
-                   'dynamic (default %(default)s)')
+    i.add_argument('--base', default='exponential', help='declared friction law: viscous, coulomb, exponential '
+                   '(the paper\'s values, unless --plant gives them); dynamic for a force-input record such as '
+                   'EMPS (default %(default)s)')
+    i.add_argument('--free', help='known plant constants to fit too, e.g. M,alpha (default: none; they stay '
+                   'as declared)')
     i.add_argument('--effects', help='comma-separated candidate effects (default: the whole library)')
-    i.add_argument('--plant', help='plant constants: paper YAML or a scenario (default: a bag\'s stored '
-                   'scenario, else Table 1)')
+    i.add_argument('--plant', help='the declared model: a scenario, a paper-style YAML, or a file with only '
+                   'plant: (default: a bag\'s stored scenario, else Table 1; friction: the paper\'s --base law)')
     i.add_argument('--columns', help='CSV column mapping, e.g. t=time_s,x=cart_m,voltage=u_V,theta=angle_rad')
     i.add_argument('--cart-alone', action='store_true', help='ignore the angle of a bag (pendulum off)')
     i.add_argument('--tables', default=str(Path(DEFAULT_DATA) / 'paper'), help='directory of Tables 5-6 '

@@ -16,12 +16,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..physics.friction import COULOMB, DYNAMIC, EXPONENTIAL, VISCOUS, bristle_path, friction_forces
+from ..physics.friction import DYNAMIC, bristle_path, friction_forces, parameter_vector
+from ..physics.params import FrictionParams
+from ..physics.plant import undeclared_forces
 from ..physics.rig import inputs_through
 
 
 @dataclass(frozen=True)
-class Param:
+class ParamSpec:
     """One parameter: unit, bounds and start value (``None`` = chosen from the data)."""
 
     name: str
@@ -44,40 +46,41 @@ class Effect:
     needs_theta: bool = False
 
 
-BASE_PARAMS = (Param('mass', 'kg', 1e-3, 1e4, None), Param('eps', 'N s/m', -1e4, 1e4, 0.0))
+BASE_PARAMS = (ParamSpec('mass', 'kg', 1e-3, 1e4, None), ParamSpec('eps', 'N s/m', 0.0, 1e4, 0.0))
 
 EFFECTS = {e.name: e for e in (
-    Effect('coulomb', (Param('Fc', 'N', 0.0, 1e4), Param('Fs_excess', 'N', 0.0, 1e4)), 'friction',
+    Effect('coulomb', (ParamSpec('Fc', 'N', 0.0, 1e4), ParamSpec('Fs_excess', 'N', 0.0, 1e4)), 'friction',
            'velocity_sign', 'Coulomb and static friction, eqs. (4)-(7): Fc sgn(x\') while sliding, the '
            'cart held up to Fs = Fc + Fs_excess (seen at breakaway): the residual jumps across x\' = 0'),
-    Effect('stribeck', (Param('v_s', 'm/s', 1e-4, 10.0, None),), 'friction',
+    Effect('stribeck', (ParamSpec('v_s', 'm/s', 1e-4, 10.0, None),), 'friction',
            'speed', 'the sliding level falls from Fs to Fc as exp(-(|x\'|/v_s)^2), eq. (8) with gamma = 2: '
            'the residual falls with speed at low |x\'|', requires=('coulomb',)),
-    Effect('presliding', (Param('sigma0', 'N/m', 1.0, 1e7, None), Param('sigma1', 'N s/m', 0.0, 1e5)),
+    Effect('presliding', (ParamSpec('sigma0', 'N/m', 1.0, 1e7, None), ParamSpec('sigma1', 'N s/m', 0.0, 1e5)),
            'friction', 'reversal', 'bristle (dynamic) friction, eqs. (10)-(11): sigma0 z replaces the '
            'sliding level; a transient after each reversal', requires=('coulomb',)),
-    Effect('asymmetry', (Param('dFc', 'N', -1e4, 1e4), Param('dFv', 'N s/m', -1e4, 1e4)), 'friction',
-           'direction', 'direction-dependent friction: Coulomb Fc + dFc forward, Fc - dFc backward '
-           '(a constant force while sliding) and viscous eps + dFv sgn(x\'); the residual is even in '
+    Effect('asymmetry', (ParamSpec('asym', '', -0.9, 0.9), ParamSpec('asym_v', 'N s/m', -1e4, 1e4)), 'friction',
+           'direction', 'direction-dependent friction, the law of physics.friction: level (1 + asym) forward, '
+           '(1 - asym) backward, static included, viscous eps + asym_v sgn(x\'); the residual is even in '
            'x\' (the same sign both ways) where friction misfits are odd'),
-    Effect('offset', (Param('F0', 'N', -1e4, 1e4),), 'force', 'mean',
+    Effect('offset', (ParamSpec('F0', 'N', -1e4, 1e4),), 'force', 'mean',
            'a constant force (slope of the track, amplifier offset): the residual has a mean'),
-    Effect('cogging', (Param('cog_sin', 'N', -1e4, 1e4), Param('cog_cos', 'N', -1e4, 1e4),
-                       Param('cog_period', 'm', 1e-4, 10.0, None)), 'force', 'position',
-           'position-periodic force (motor cogging, screw ripple) a sin(2 pi x/P) + b cos(2 pi x/P): '
+    Effect('cogging', (ParamSpec('cog_a', 'N', -1e4, 1e4), ParamSpec('cog_b', 'N', -1e4, 1e4),
+                       ParamSpec('cog_period', 'm', 1e-4, 10.0, None)), 'force', 'position',
+           'position-periodic force (motor cogging, screw ripple) A sin(2 pi x/P + phi) of physics.plant, '
+           'fitted as a sin + b cos (a = A cos phi, b = A sin phi): '
            'a peak in the spectrum of the residual over position'),
-    Effect('backlash', (Param('gap', 'm', 0.0, 0.05),), 'sensor', 'reversal',
+    Effect('backlash', (ParamSpec('gap', 'm', 0.0, 0.05),), 'sensor', 'reversal',
            'play of width gap between cart and encoder: the measured position dwells at each '
            'reversal while the cart moves gap; spikes of residual right after reversals'),
-    Effect('deadzone', (Param('dz', 'input unit', 0.0, 1e3, None),), 'input', 'voltage',
+    Effect('deadzone', (ParamSpec('dz', 'input unit', 0.0, 1e3, None),), 'input', 'voltage',
            'input deadzone: |u| < dz gives no force, beyond it u - sgn(u) dz; the residual is an odd '
            'step in u'),
-    Effect('saturation', (Param('u_max', 'input unit', 1e-6, 1e6, None),), 'input', 'voltage',
+    Effect('saturation', (ParamSpec('u_max', 'input unit', 1e-6, 1e6, None),), 'input', 'voltage',
            'the drive clips |u| at u_max: the residual grows with |u| beyond it'),
-    Effect('delay', (Param('delay', 's', 0.0, 0.5, None),), 'input', 'lag',
+    Effect('delay', (ParamSpec('delay', 's', 0.0, 0.5, None),), 'input', 'lag',
            'transport delay between command and force (or sensor): the residual correlates with '
            'the input\'s rate at a lag'),
-    Effect('sensor_bias', (Param('theta_bias', 'rad', -0.3, 0.3),), 'sensor', 'pendulum_mean',
+    Effect('sensor_bias', (ParamSpec('theta_bias', 'rad', -0.3, 0.3),), 'sensor', 'pendulum_mean',
            'constant angle-encoder offset: the pendulum equation (4/3) l theta\'\' = g sin(theta) - '
            'x\'\' cos(theta) has a mean residual of about g * bias', needs_theta=True),
 )}
@@ -96,7 +99,7 @@ def shifted(t: np.ndarray, u: np.ndarray, delay: float) -> np.ndarray:
     return np.interp(t - delay, t, u, left=u[0])
 
 
-def input_effects(t: np.ndarray, u: np.ndarray, p: dict, active) -> np.ndarray:
+def effective_input(t: np.ndarray, u: np.ndarray, p: dict, active) -> np.ndarray:
     """u_eff: the input after delay, deadzone and saturation (same unit as u), the rig's law."""
     if 'delay' in active:
         u = shifted(t, u, p['delay'])
@@ -140,23 +143,25 @@ def dwell_profile(t: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 
 def friction_vector(p: dict, active) -> tuple:
-    """The identified friction as the parameter vector of :mod:`ipfric_core.physics.friction`.
+    """The identified friction as the parameter vector of :mod:`ipfric_core.physics.friction`
+    (:func:`~ipfric_core.physics.friction.parameter_vector` of the law's FrictionParams).
 
-    (model code, smoothing, eps, mu_s, mu_c, v_s, gamma, sigma0, sigma1, delta, F_N), see
-    :func:`ipfric_core.physics.friction.parameter_vector`. Levels are in N (F_N = 1): mu_c = Fc, mu_s = Fc + Fs_excess, gamma = 2. Without the
-    stribeck effect the dynamic law's level stays at Fc. Fc is floored at 1e-9 N, where
-    the laws divide by the level.
+    Levels are in N (F_N = 1): mu_c = Fc, mu_s = Fc + Fs_excess, gamma = 2. Without the
+    stribeck effect the dynamic law's level stays at Fc. Fc is floored at 1e-9 N, where the
+    laws divide by the level.
     """
+    asym = {'asymmetry': p['asym'], 'asymmetry_viscous': p['asym_v']} if 'asymmetry' in active else {}
     if 'coulomb' not in active:
-        return (VISCOUS, 0.0, p['eps'], 0.0, 0.0, 1.0, 2.0, 0.0, 0.0, 0.0, 1.0)
+        return parameter_vector(FrictionParams(model='viscous', eps=p['eps'], **asym), 1.0)
     fc = max(p['Fc'], 1e-9)
     stribeck = 'stribeck' in active
     if 'presliding' in active:
-        model, fs = DYNAMIC, fc + p['Fs_excess'] if stribeck else fc
+        law = FrictionParams(model='dynamic', eps=p['eps'], mu_c=fc, mu_s=fc + p['Fs_excess'] if stribeck else fc,
+                             v_s=p['v_s'] if stribeck else 1.0, sigma0=p['sigma0'], sigma1=p['sigma1'], **asym)
     else:
-        model, fs = (EXPONENTIAL if stribeck else COULOMB), fc + p['Fs_excess']
-    return (model, 0.0, p['eps'], fs, fc, p['v_s'] if stribeck else 1.0, 2.0,
-            p.get('sigma0', 0.0), p.get('sigma1', 0.0), 0.0, 1.0)
+        law = FrictionParams(model='exponential' if stribeck else 'coulomb', eps=p['eps'], mu_c=fc,
+                             mu_s=fc + p['Fs_excess'], v_s=p['v_s'] if stribeck else 1.0, **asym)
+    return parameter_vector(law, 1.0)
 
 
 def static_level(p: dict, active) -> float:
@@ -166,13 +171,11 @@ def static_level(p: dict, active) -> float:
 
 def position_force(x, p: dict, active):
     """Forces fixed to the track or constant [N] (offset, cogging): they act at rest too."""
-    r = np.zeros_like(np.asarray(x, float))
-    if 'offset' in active:
-        r = r + p['F0']
+    amp, phase, period = 0.0, 0.0, 1.0
     if 'cogging' in active:
-        ph = 2 * np.pi * x / p['cog_period']
-        r = r + p['cog_sin'] * np.sin(ph) + p['cog_cos'] * np.cos(ph)
-    return r
+        amp, phase, period = np.hypot(p['cog_a'], p['cog_b']), np.arctan2(p['cog_b'], p['cog_a']), p['cog_period']
+    ef = (float(amp), float(period), float(phase), float(p['F0']) if 'offset' in active else 0.0)
+    return undeclared_forces(ef, np.ascontiguousarray(x, float))
 
 
 def resisting_force(x, v, p: dict, active, dt: float) -> np.ndarray:
@@ -184,8 +187,4 @@ def resisting_force(x, v, p: dict, active, dt: float) -> np.ndarray:
     v = np.ascontiguousarray(v, float)
     fp = friction_vector(p, active)
     z = bristle_path(fp, v, dt) if fp[0] == DYNAMIC else np.zeros_like(v)
-    r = -friction_forces(fp, v, z)
-    if 'asymmetry' in active:
-        speed = np.abs(v)
-        r = r + p['dFc'] * (speed > 0) + p['dFv'] * speed
-    return r + position_force(x, p, active)
+    return -friction_forces(fp, v, z) + position_force(x, p, active)

@@ -4,13 +4,22 @@ A :class:`Record` is a sampled experiment on a prismatic axis: time t [s], posit
 x [m], the input u in its own unit (V) with the factor ``gain`` that turns it into a
 force [N/unit], and, when a pendulum is attached, its angle theta [rad from upright].
 Loaders: a run bag of ``./ipfric run`` (measured topics only: encoders and commands),
-a CSV table, the EMPS benchmark files (force ``gtau * vir``, position ``qm``).
-Bad input is refused with a :class:`ConfigError` naming the problem.
+a CSV table (plain or gzip), the EMPS benchmark files (force ``gtau * vir``, position ``qm``).
+Bad input is refused with a :class:`ConfigError` naming the problem, the row and the column.
+
+Data as rigs write them are taken as they are and their defects named in ``Record.notes``:
+uneven time stamps (each command is held until the next stamp), sample overruns (a stamp
+that jumps, then encoders frozen: those readings are marked invalid), an angle that wraps
+at +/-pi (unwrapped) or is measured from hanging (pi at upright: mapped to upright).
 """
 from __future__ import annotations
 
 import csv
-from dataclasses import dataclass, replace
+import gzip
+import io
+import math
+from array import array
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +27,10 @@ import numpy as np
 from ..physics.params import ConfigError, PlantParams
 
 MIN_SAMPLES = 200
+MAX_ROWS = 20_000_000   # a CSV longer than this is refused (about 1 GB of text)
+MAX_VOLTAGE = 1e3       # |u| beyond this is not a drive command [V]
+OVERRUN_JUMP = 1.75     # a stamp step this many times the median period starts an overrun
+MAX_FROZEN = 5          # samples after a jump that may repeat the last reading
 
 
 @dataclass(frozen=True)
@@ -29,6 +42,8 @@ class Record:
     pendulum : (m [kg], l [m], g [m/s^2]) when theta is measured, else None
     normal_force : F_N [N] used to express friction as coefficients mu
     stick_velocity : |x'| [m/s] below which a sample counts as stuck (left out of the fit)
+    valid : False where a reading is stale (a sample overrun); None = all valid
+    notes : what loading found and did (overruns, resampling, angle mapping)
     """
 
     name: str
@@ -42,10 +57,26 @@ class Record:
     normal_force: float = 1.0
     stick_velocity: float = 0.0
     cutoff_hz: float = 20.0
+    valid: np.ndarray | None = None
+    notes: tuple = field(default=())
 
     @property
     def dt(self) -> float:
         return float(np.median(np.diff(self.t)))
+
+    @property
+    def valid_mask(self) -> np.ndarray:
+        return np.ones(len(self.t), bool) if self.valid is None else self.valid
+
+    @property
+    def x_resolution(self) -> float:
+        """The cart encoder's count [m]: the smallest step of x."""
+        return smallest_step(self.x)
+
+    @property
+    def theta_resolution(self) -> float:
+        """The angle encoder's count [rad]: the smallest step of theta."""
+        return smallest_step(self.theta) if self.theta is not None else 1.0
 
     def split(self, fraction: float) -> tuple['Record', 'Record']:
         """(first ``fraction``, rest) in time: estimation and validation parts."""
@@ -53,14 +84,53 @@ class Record:
         parts = []
         for sl, tag in ((slice(0, k), 'estimation'), (slice(k, None), 'validation')):
             parts.append(replace(self, name=f'{self.name} ({tag})', t=self.t[sl], x=self.x[sl], u=self.u[sl],
-                                 theta=None if self.theta is None else self.theta[sl]))
+                                 theta=None if self.theta is None else self.theta[sl],
+                                 valid=None if self.valid is None else self.valid[sl]))
         return parts[0], parts[1]
 
 
+def smallest_step(y: np.ndarray) -> float:
+    """The smallest nonzero step of a sampled signal (an encoder's count), 1.0 if it never moves."""
+    steps = np.abs(np.diff(y))
+    steps = steps[steps > 1e-12 * max(1.0, float(np.max(np.abs(y))))]
+    return float(steps.min()) if len(steps) else 1.0
+
+
+def overruns(t: np.ndarray, readings: list) -> np.ndarray:
+    """False at stale readings: after a stamp that jumps by more than OVERRUN_JUMP median
+    periods, the samples that repeat its reading (every encoder frozen), at most MAX_FROZEN of
+    them. A real-time loop that overran wrote them."""
+    dt = np.diff(t)
+    valid = np.ones(len(t), bool)
+    for j in np.flatnonzero(dt > OVERRUN_JUMP * np.median(dt)) + 1:
+        k = j + 1
+        while k < len(t) and k - j <= MAX_FROZEN and all(r[k] == r[j] for r in readings):
+            valid[k] = False
+            k += 1
+    return valid
+
+
+def upright_angle(theta: np.ndarray) -> tuple[np.ndarray, list[str]]:
+    """theta from upright [rad]: unwrapped, and shifted by pi when measured from hanging."""
+    notes = []
+    th = np.unwrap(theta)
+    if np.any(np.abs(np.diff(theta)) > np.pi):
+        notes.append('angle wrapped at +/-pi: unwrapped')
+    turns = np.round(np.median(th) / (2 * np.pi))
+    if np.median(np.abs(th - 2 * np.pi * turns)) > np.pi / 2:
+        th = th - np.pi
+        notes.append('angle measured from hanging (pi at upright): mapped to upright = 0')
+    turns = np.round(np.median(th) / (2 * np.pi))
+    if turns:
+        th = th - 2 * np.pi * turns
+    return th, notes
+
+
 def check_record(rec: Record) -> Record:
-    """Refuse NaN, non-monotonic time, too few samples and ranges that betray wrong units."""
+    """Refuse what cannot be measured data (NaN, time going back, absurd ranges, too few
+    samples); take what rigs write (uneven stamps, overruns, wrapped or hanging angles)."""
     n = len(rec.t)
-    arrays = {'t': rec.t, 'x': rec.x, 'u': rec.u}
+    arrays = {'t': rec.t, 'x': rec.x, 'voltage': rec.u}
     if rec.theta is not None:
         arrays['theta'] = rec.theta
     for k, a in arrays.items():
@@ -68,29 +138,51 @@ def check_record(rec: Record) -> Record:
             raise ConfigError(f'{rec.name}: column {k} has {len(a)} samples, t has {n}')
         bad = np.nonzero(~np.isfinite(a))[0]
         if len(bad):
-            raise ConfigError(f'{rec.name}: column {k} is NaN or infinite at row {bad[0]} '
+            raise ConfigError(f'{rec.name}: column {k} is NaN or infinite at row {bad[0] + 1} '
                               f'({len(bad)} such rows); clean or cut the data')
     if n < MIN_SAMPLES:
         raise ConfigError(f'{rec.name}: {n} samples is too short; at least {MIN_SAMPLES} are needed')
     d = np.diff(rec.t)
     if np.any(d <= 0):
         i = int(np.nonzero(d <= 0)[0][0])
-        raise ConfigError(f'{rec.name}: time is not increasing at row {i + 1} '
+        raise ConfigError(f'{rec.name}: time is not increasing at row {i + 2} '
                           f'(t = {rec.t[i]:g} then {rec.t[i + 1]:g} s)')
-    if np.max(d) > 1.5 * np.min(d) + 1e-9:
-        raise ConfigError(f'{rec.name}: samples are not evenly spaced (dt from {np.min(d):g} to '
-                          f'{np.max(d):g} s); resample to a constant period')
+    period = float(np.median(d))
+    if not 1e-5 <= period <= 0.1:
+        raise ConfigError(f'{rec.name}: column t has a median sample period of {period:g}; expected seconds '
+                          f'between 1e-05 and 0.1 (is t in ms or ns?)')
     if np.ptp(rec.x) > 20.0:
-        raise ConfigError(f'{rec.name}: x spans {np.ptp(rec.x):g}; expected metres (a prismatic axis '
+        raise ConfigError(f'{rec.name}: column x spans {np.ptp(rec.x):g}; expected metres (a prismatic axis '
                           f'moves less than 20 m); is it in mm or counts?')
     if np.ptp(rec.x) == 0.0:
-        raise ConfigError(f'{rec.name}: x never changes; nothing moved')
-    if rec.t[-1] - rec.t[0] > 1e5:
-        raise ConfigError(f'{rec.name}: t spans {rec.t[-1] - rec.t[0]:g}; expected seconds (ms or ns?)')
-    if rec.theta is not None and np.max(np.abs(rec.theta)) > 2 * np.pi:
-        raise ConfigError(f'{rec.name}: |theta| reaches {np.max(np.abs(rec.theta)):g}; expected radians '
-                          f'from upright (degrees?)')
-    return rec
+        raise ConfigError(f'{rec.name}: column x never changes; nothing moved')
+    big = np.flatnonzero(np.abs(rec.u) > MAX_VOLTAGE)
+    if len(big):
+        raise ConfigError(f'{rec.name}: column voltage is {rec.u[big[0]]:g} at row {big[0] + 1}; allowed '
+                          f'|voltage| <= {MAX_VOLTAGE:g} (is it a drive command?)')
+    if not np.any(rec.u):
+        raise ConfigError(f'{rec.name}: column voltage is 0 throughout; nothing drove the axis')
+    notes = list(rec.notes)
+    theta = rec.theta
+    if theta is not None:
+        wrapped = np.abs(np.angle(np.exp(1j * theta)))
+        off_axis = np.median(np.minimum(wrapped, np.pi - wrapped))   # from upright or hanging [rad]
+        if np.max(np.abs(theta)) > 2 * np.pi and off_axis > 0.5:
+            raise ConfigError(f'{rec.name}: column theta reaches {np.max(np.abs(theta)):g}; expected radians '
+                              f'from upright or from hanging (degrees?)')
+        theta, found = upright_angle(theta)
+        notes += found
+        if np.max(np.abs(theta)) > np.pi / 2:
+            raise ConfigError(f'{rec.name}: column theta leaves +/-90 deg of upright (to {np.max(np.abs(theta)):g} '
+                              f'rad); cut the record to the balanced part')
+    valid = overruns(rec.t, [rec.x] + ([theta] if theta is not None else []))
+    if not valid.all():
+        notes.append(f'{int((~valid).sum())} stale readings after {int(np.sum(np.diff(valid.astype(int)) == -1))} '
+                     f'sample overruns (stamp jump, encoders frozen): not compared')
+    if np.max(d) > 1.5 * np.min(d) + 1e-9:
+        notes.append(f'uneven stamps (period {np.min(d):g} to {np.max(d):g} s, median {period:g} s): '
+                     f'each command held until the next stamp')
+    return replace(rec, theta=theta, valid=valid, notes=tuple(notes))
 
 
 def _rig_record(name, t, x, u, theta, plant: PlantParams) -> Record:
@@ -101,10 +193,32 @@ def _rig_record(name, t, x, u, theta, plant: PlantParams) -> Record:
                                pend, fn, stick_velocity=2e-3, cutoff_hz=25.0))
 
 
-def load_csv(path: str | Path, plant: PlantParams, columns: dict | None = None) -> Record:
-    """CSV with a header: t [s], x [m], voltage [V] and optionally theta [rad from upright].
+def _text_lines(path: Path):
+    """The lines of a text file (gzip when it ends in .gz), a byte-order mark dropped."""
+    try:
+        raw = path.open('rb')
+    except OSError as exc:
+        raise ConfigError(f'{path}: cannot read ({exc.strerror})') from exc
+    if path.suffix.lower() == '.gz':
+        raw = gzip.open(raw)
+    stream = io.TextIOWrapper(raw, encoding='utf-8-sig', errors='strict', newline='')
+    try:
+        for i, line in enumerate(stream, 1):
+            yield i, line
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f'{path}: not a text (UTF-8) CSV file: {exc.reason} near byte {exc.start}') from exc
+    except (OSError, EOFError) as exc:
+        raise ConfigError(f'{path}: cannot read ({exc})') from exc
+    finally:
+        stream.close()
 
-    ``columns`` maps these names to the file's headers, e.g. {'x': 'cart_m'}.
+
+def load_csv(path: str | Path, plant: PlantParams, columns: dict | None = None) -> Record:
+    """CSV (or .csv.gz) with a header: t [s], x [m], voltage [V] and optionally theta [rad].
+
+    ``columns`` maps these names to the file's headers, e.g. {'x': 'cart_m'}. Lines that
+    start with '#' are comments. Read as a stream into typed arrays (memory about 8 bytes
+    a value); at most MAX_ROWS rows.
     """
     path = Path(path)
     cols = {'t': 't', 'x': 'x', 'voltage': 'voltage', 'theta': 'theta'}
@@ -113,30 +227,37 @@ def load_csv(path: str | Path, plant: PlantParams, columns: dict | None = None) 
         raise ConfigError(f'column mapping: unknown name(s) {", ".join(sorted(unknown))}; '
                           f'allowed: t, x, voltage, theta')
     cols.update(columns or {})
-    try:
-        lines = [ln for ln in path.read_text().splitlines() if ln.strip() and not ln.startswith('#')]
-    except OSError as exc:
-        raise ConfigError(f'{path}: cannot read ({exc.strerror})') from exc
-    if not lines:
+    lines = ((i, ln) for i, ln in _text_lines(path) if ln.strip() and not ln.lstrip().startswith('#'))
+    first = next(lines, None)
+    if first is None:
         raise ConfigError(f'{path}: empty file; expected a header t,x,voltage[,theta]')
-    reader = csv.reader(lines)
-    header = [h.strip() for h in next(reader)]
+    header = [h.strip() for h in next(csv.reader([first[1]]))]
     for need in ('t', 'x', 'voltage'):
         if cols[need] not in header:
             raise ConfigError(f'{path}: missing column {cols[need]!r} ({need}); header has '
                               f'{", ".join(header)}; map columns with --columns {need}=NAME')
-    rows = list(reader)
-    try:
-        data = np.array([[float(v) if v.strip() else np.nan for v in r] for r in rows], float)
-    except ValueError as exc:
-        raise ConfigError(f'{path}: non-numeric value ({exc})') from exc
-    if data.ndim != 2 or data.shape[1] != len(header):
-        raise ConfigError(f'{path}: rows do not all have {len(header)} fields')
-
-    def col(name):
-        return data[:, header.index(cols[name])]
-    theta = col('theta') if cols['theta'] in header else None
-    return _rig_record(path.name, col('t'), col('x'), col('voltage'), theta, plant)
+    names = [n for n in ('t', 'x', 'voltage', 'theta') if cols[n] in header]
+    where = [header.index(cols[n]) for n in names]
+    data = {n: array('d') for n in names}
+    rows = 0
+    for lineno, line in lines:
+        fields = next(csv.reader([line]))
+        if len(fields) != len(header):
+            raise ConfigError(f'{path}: row {lineno} has {len(fields)} fields, the header has {len(header)} '
+                              f'({", ".join(header)})')
+        for n, j in zip(names, where):
+            try:
+                data[n].append(float(fields[j]))
+            except ValueError:
+                raise ConfigError(f'{path}: row {lineno}, column {cols[n]!r}: {fields[j].strip()!r} is not a '
+                                  f'number') from None
+        rows += 1
+        if rows > MAX_ROWS:
+            raise ConfigError(f'{path}: more than {MAX_ROWS} rows; cut or decimate the log (at most {MAX_ROWS})')
+    if rows == 0:
+        raise ConfigError(f'{path}: a header and no data rows; expected rows of {", ".join(header)}')
+    arrays = {n: np.frombuffer(data[n], float) for n in names}
+    return _rig_record(path.name, arrays['t'], arrays['x'], arrays['voltage'], arrays.get('theta'), plant)
 
 
 def load_bag(path: str | Path, plant: PlantParams | None = None, cart_alone: bool = False) -> Record:
@@ -167,13 +288,18 @@ def load_emps(path: str | Path) -> Record:
     from scipy.io import loadmat
     try:
         d = loadmat(str(path))
-    except (OSError, ValueError) as exc:
-        raise ConfigError(f'{path}: not a readable MATLAB file ({exc})') from exc
+    except Exception as exc:  # scipy raises many types on a damaged file: all mean "not readable"
+        raise ConfigError(f'{path}: not a readable MATLAB file ({type(exc).__name__}: {exc})') from exc
     missing = [k for k in ('t', 'qm', 'vir', 'gtau') if k not in d]
     if missing:
         raise ConfigError(f'{path}: missing variable(s) {", ".join(missing)}; an EMPS file has t, qm, vir, gtau')
-    return check_record(Record(Path(path).name, d['t'].ravel().astype(float), d['qm'].ravel().astype(float),
-                               d['vir'].ravel().astype(float), float(d['gtau'].ravel()[0]),
+    try:
+        cols = [np.asarray(d[k], float).ravel() for k in ('t', 'qm', 'vir', 'gtau')]
+    except (TypeError, ValueError) as exc:
+        raise ConfigError(f'{path}: variables t, qm, vir, gtau must be numeric arrays ({exc})') from exc
+    if len(cols[3]) != 1 or not np.isfinite(cols[3][0]) or cols[3][0] <= 0:
+        raise ConfigError(f'{path}: gtau must be one positive number [N/V], got {cols[3][:3]}')
+    return check_record(Record(Path(path).name, cols[0], cols[1], cols[2], float(cols[3][0]),
                                normal_force=1.0, stick_velocity=0.0, cutoff_hz=20.0))
 
 
@@ -183,7 +309,7 @@ def load(path: str | Path, plant: PlantParams | None, columns: dict | None = Non
 
     ``plant`` None: a bag's stored scenario, Table 1 for a CSV."""
     p = Path(path)
-    if p.suffix.lower() == '.csv':
+    if p.suffix.lower() == '.csv' or p.name.lower().endswith('.csv.gz'):
         return load_csv(p, plant or PlantParams(), columns)
     if p.suffix.lower() == '.mat':
         return load_emps(p)

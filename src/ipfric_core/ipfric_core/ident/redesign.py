@@ -9,64 +9,20 @@ runs on the same plant and the oscillation shrinks.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import replace
 from pathlib import Path
 
 import yaml
 
-from .records import trajectory_record
-from .effects import BASE_MODELS
-from .identify import identify
-from .report import write_report
+from ..analysis.sweep import classify_run
 from ..design.lqr import design
-from ..physics.params import ConfigError, FrictionParams, PlantParams
+from ..physics.params import FrictionParams, PlantParams
 from ..physics.rig import PlantTruth
 from ..run.scenario import Scenario, load_scenario
-from ..analysis.sweep import classify_run
-
-
-def identified_friction(r: dict) -> FrictionParams:
-    """The paper's friction model closest to the identified one (result dict of a search)."""
-    f = r['friction']
-    eff = set(r['effects_added']) | set(BASE_MODELS[r['base_model']])
-    data = {'model': 'viscous', 'eps': max(0.0, f['eps'])}
-    if 'coulomb' in eff:
-        data.update(model='coulomb', mu_c=f['mu_c'], mu_s=f['mu_s'])
-    if 'stribeck' in eff:
-        data.update(model='exponential', v_s=f['v_s'], gamma=2.0)
-    if 'presliding' in eff:
-        data.update(model='dynamic', sigma0=f['sigma0'], sigma1=f['sigma1'])
-        data.setdefault('v_s', 0.1)  # without a Stribeck excess (mu_s = mu_c) v_s plays no part
-        data.setdefault('gamma', 2.0)
-    try:
-        return FrictionParams.from_dict(data, 'identified friction')
-    except ConfigError as exc:
-        raise ConfigError(f'{exc} (the identified friction does not fit a cart-pendulum scenario; '
-                          f'are the data from the rig?)') from exc
-
-
-def identified_truth(r: dict, dt: float) -> PlantTruth:
-    """Undeclared effects found by the search, as the simulator's ``plant_truth``."""
-    p = {k: v['value'] for k, v in r['params'].items()}
-    eff = r['effects_added']
-    vals = {}
-    if 'cogging' in eff:
-        vals.update(cogging_N=-math.copysign(math.hypot(p['cog_sin'], p['cog_cos']), p['cog_sin']),
-                    cogging_period_m=p['cog_period'])
-    if 'deadzone' in eff:
-        vals['deadzone_V'] = p['dz']
-    if 'saturation' in eff:
-        vals['saturation_V'] = p['u_max']
-    if 'delay' in eff:
-        vals['input_delay_s'] = round(p['delay'] / dt) * dt
-    if 'asymmetry' in eff:
-        vals['asymmetry_N'] = p['dFc']
-    if 'backlash' in eff:
-        vals['backlash_m'] = p['gap']
-    if 'sensor_bias' in eff:
-        vals['bias_theta_rad'] = p['theta_bias']
-    return PlantTruth(**vals)
+from .ladder import run_ladder
+from .ladder_report import write_ladder_report
+from .model import load_declared
+from .records import trajectory_record
 
 
 def design_friction(friction: FrictionParams) -> FrictionParams:
@@ -82,23 +38,26 @@ def designed_gain(plant: PlantParams, friction: FrictionParams, Q, R: float) -> 
     return [float(k) for k in design(plant, friction, Q, R).gain[:4]]
 
 
-def export_scenario(path: str | Path, r: dict, base: Scenario, rig: Scenario | None = None) -> dict:
-    """Write the identified scenario to ``path`` (and ``<stem>_on_rig.yaml`` when ``rig`` is given).
+def export_scenario(path: str | Path, label: str, idf: dict, base: Scenario, rig: Scenario | None = None) -> dict:
+    """Write the identified rig to ``path`` (and ``<stem>_on_rig.yaml`` when ``rig`` is given).
 
-    sim_node: ``base``'s settings with the identified friction and effects; controller_node:
-    the gain designed (LQR, ``base``'s Q and R) on the identified friction (:func:`design_friction`). With ``rig``, a
-    second file runs that gain on the rig's own sim_node (the plant you ran on).
+    ``idf``: the identified model's sections (:func:`ladder_report.identified`): its own plant
+    constants, its friction as coefficients of its own normal force, every effect parameter
+    as ``plant_truth`` (cogging phase, asymmetry, offset included). sim_node: ``base``'s
+    settings with them; controller_node: the gain designed (LQR, ``base``'s Q and R) on the
+    identified plant and friction (:func:`design_friction`). With ``rig``, a second file runs
+    that gain on the rig's own sim_node (the plant you ran on).
     """
     path = Path(path)
-    friction = identified_friction(r)
-    truth = identified_truth(r, base.sample_period)
+    plant = PlantParams(**idf['plant'])
+    friction = FrictionParams(**idf['friction'])
+    truth = PlantTruth(**idf['plant_truth'])
     c = base.controller
-    gain = designed_gain(base.plant, design_friction(friction), c.Q, c.R)
+    gain = designed_gain(plant, design_friction(friction), c.Q, c.R)
     ctrl = replace(c, gain_source='yaml', gain=tuple(gain), design_friction=None)
     path.parent.mkdir(parents=True, exist_ok=True)
-    header = (f'# Identified plant ({r["base_model"]} + {", ".join(r["effects_added"]) or "no effect"}) and the\n'
-              f'# LQR gain designed on it. Written by ./ipfric identify --export.\n')
-    identified = replace(base, friction=friction, truth=truth, controller=ctrl)
+    header = (f'# Identified rig ({label}) and the LQR gain designed on it. Written by ./ipfric identify --export.\n')
+    identified = replace(base, plant=plant, friction=friction, truth=truth, controller=ctrl)
     path.write_text(header + yaml.safe_dump(identified.to_ros_params(), sort_keys=False))
     load_scenario(path)  # the file must read back as a valid scenario
     out = {'scenario': str(path), 'friction': friction.to_dict(), 'plant_truth': truth.to_dict(), 'gain': gain}
@@ -117,8 +76,11 @@ def _oscillation(o, traj) -> dict:
 
 
 def close_the_loop(scenario_path: str | Path, out: str | Path, duration: float = 20.0,
-                   base_model: str = 'viscous', plots: bool = True) -> dict:
-    """Run, identify on the run's measured data, redesign, run again; amplitudes before/after."""
+                   base_model: str = 'exponential', plots: bool = True) -> dict:
+    """Run, identify on the run's measured data, redesign, run again; amplitudes before/after.
+
+    The declared model is the scenario's design side: its plant and the paper's ``base_model``
+    friction law (the friction the controller's designer assumed is refitted by the ladder)."""
     out = Path(out)
     sc = load_scenario(scenario_path)
     o0, traj0 = classify_run(sc, duration)
@@ -126,12 +88,15 @@ def close_the_loop(scenario_path: str | Path, out: str | Path, duration: float =
     rec = trajectory_record(f'{Path(scenario_path).name}, gain {[round(k, 2) for k in sc.gain()]}',
                             traj0, sc.plant)
     est, val = rec.split(0.6)
-    r = write_report(identify(est, val, base_model), out / 'identification', plots)
-    exported = export_scenario(out / 'identified.yaml', r, sc, rig=sc)
+    model = load_declared(None, base_model, True, sc.plant)
+    r = write_ladder_report(run_ladder(est, val, model), out / 'identification', plots)
+    idf = r['identified']
+    exported = export_scenario(out / 'identified.yaml', r['ladder'][-1]['step'], idf, sc, rig=sc)
     sc1 = load_scenario(exported['on_rig'])
     after = _oscillation(*classify_run(sc1, duration))
     return {'scenario': str(scenario_path), 'duration_s': duration, 'gain_before': sc.gain(),
             'gain_after': exported['gain'], 'before': before, 'after': after,
-            'identified': {k: r[k] for k in ('base_model', 'effects_added', 'friction', 'error_before',
-                                              'error_after')},
+            'identified': {'base_model': base_model, 'effects_added': r['effects_added'],
+                           'friction': idf['friction'], 'plant_truth': idf['plant_truth'],
+                           'ladder': [{'step': s['step'], 'validation': s['validation']} for s in r['ladder']]},
             'export': exported, 'report': str(out / 'identification' / 'report.md')}

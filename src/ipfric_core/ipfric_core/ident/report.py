@@ -11,7 +11,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from . import effects as fx  # noqa: E402
-from .identify import analyse, balance, errors, param_specs  # noqa: E402
+from . import shooting  # noqa: E402
+from .equation_error import analyse, balance, errors, model_vectors, param_specs  # noqa: E402
 from .residual import SIGNATURES, time_since_reversal  # noqa: E402
 
 
@@ -25,7 +26,7 @@ def friction_summary(params: dict, active, normal_force: float) -> dict:
         if k in params:
             out[k] = params[k]
     if 'cogging' in active:
-        out['cogging_amplitude_N'] = float(np.hypot(params['cog_sin'], params['cog_cos']))
+        out['cogging_amplitude_N'] = float(np.hypot(params['cog_a'], params['cog_b']))
     return out
 
 
@@ -35,6 +36,7 @@ def result_dict(res: dict) -> dict:
     base, fit = res['base_fit'], res['fit']
     units = {s.name: s.unit for s in param_specs(fit.active)}
     a0, a1 = analyse(pe, base), analyse(pe, fit)
+    win = shooting.cart_windows(pv.rec)
     return {
         'data': {'estimation': pe.rec.name, 'validation': pv.rec.name, 'samples_used': [pe.n_used, pv.n_used],
                  'cutoff_hz': pe.rec.cutoff_hz, 'decimation': pe.q, 'stick_velocity_mps': pe.rec.stick_velocity},
@@ -46,6 +48,8 @@ def result_dict(res: dict) -> dict:
                          'validation': errors(pv, base.params, base.active)},
         'error_after': {'estimation': errors(pe, fit.params, fit.active),
                         'validation': errors(pv, fit.params, fit.active)},
+        'simulation_error': shooting.summary(shooting.predict(model_vectors(pv.rec, fit.params, fit.active), pv.rec, win),
+                                             pv.rec, win, 'x'),
         'residual_white_before': a0['whiteness']['white'],
         'residual_white_after': a1['whiteness']['white'],
         'effects_tried': res['tried'],
@@ -82,13 +86,13 @@ def figures(res: dict, out: Path) -> list[str]:
     ax.plot(pe.t, b1.model, lw=0.7, label='model: ' + '+'.join(('base',) + fit.active))
     ax.set(xlabel='time (s)', ylabel='force (N)', title='force balance on the estimation data')
     ax.legend()
-    files.append(_save(fig, out / 'fit.png'))
+    files.append(save_figure(fig, out / 'fit.png'))
     fig, ax = plt.subplots(figsize=(10, 4))
     ax.plot(pe.t[b0.used], b0.r[b0.used], '.', ms=2, label=f'before ({res["base_model"]})')
     ax.plot(pe.t[b1.used], b1.r[b1.used], '.', ms=2, label='after')
     ax.set(xlabel='time (s)', ylabel='residual (N)', title='residual before and after the search')
     ax.legend()
-    files.append(_save(fig, out / 'residual.png'))
+    files.append(save_figure(fig, out / 'residual.png'))
     fig, ax = plt.subplots(1, 2, figsize=(10, 4))
     for a, key, lab in ((ax[0], 'acf', 'autocorrelation'), (ax[1], 'ccf', 'cross-correlation with u')):
         for tag, fb in (('before', base), ('after', fit)):
@@ -99,7 +103,7 @@ def figures(res: dict, out: Path) -> list[str]:
         a.axhspan(-w['band'], w['band'], color='0.85', label='95 % band')
         a.set(xlabel='lag (s)', title=lab)
         a.legend()
-    files.append(_save(fig, out / 'autocorrelation.png'))
+    files.append(save_figure(fig, out / 'autocorrelation.png'))
     for prev, name in zip(res['steps'], [e for e in fit.active if e not in base.active]):
         bp = balance(pe, prev.params, prev.active)  # the residual before the effect was added
         var, label = _signature_axis(name, bp, pe)
@@ -107,11 +111,12 @@ def figures(res: dict, out: Path) -> list[str]:
         ax.plot(var, bp.r[bp.used], '.', ms=2)
         ax.set(xlabel=label, ylabel='residual (N)',
                title=f'{name}: residual against {SIGNATURES[fx.EFFECTS[name].signature]}')
-        files.append(_save(fig, out / f'signature_{name}.png'))
+        files.append(save_figure(fig, out / f'signature_{name}.png'))
     return files
 
 
-def _save(fig, path: Path) -> str:
+def save_figure(fig, path: Path) -> str:
+    """Write ``fig`` as a PNG and close it; returns the path."""
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -129,6 +134,9 @@ def markdown(r: dict) -> str:
         e = r[tag]
         lines.append(f'| {tag.split("_")[1]} | {e["estimation"]["rms"]:.4g} | {e["estimation"]["relative_percent"]:.3f} '
                      f'| {e["validation"]["rms"]:.4g} | {e["validation"]["relative_percent"]:.3f} |')
+    s = r['simulation_error']
+    lines += ['', f'Simulation error on the validation data (multiple shooting, {s["x_windows"]} windows): '
+              f'{s["x_rms_counts"]:.3g} encoder counts RMS, {s["x_percent"]:.3g} % of the motion within the windows.']
     lines += ['', f'Residual white before: {r["residual_white_before"]}, after: {r["residual_white_after"]} '
               f'(autocorrelation lags outside the 95 % band: {r["whiteness_before"]["acf_outside"]} -> '
               f'{r["whiteness_after"]["acf_outside"]} of {r["whiteness_after"]["max_lag"]}).', '',

@@ -51,6 +51,7 @@ _WHERE = {
     'friction_now': 'simulate',
     'held': 'simulate',
     'held_force': 'plant',
+    'holding_margin': 'friction',
     'holds': 'friction',
     'input_effects': 'rig',
     'inputs_through': 'rig',
@@ -71,6 +72,7 @@ _WHERE = {
     'stribeck_level': 'friction',
     'stuck_theta_acceleration': 'plant',
     'undeclared_force': 'plant',
+    'undeclared_forces': 'plant',
     'warm_up': 'closedloop',
 }
 

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 
 from .compiled import compiled
 from .friction import Friction, bristle_rate, friction_force
@@ -75,6 +77,15 @@ def undeclared_force(ef, x: float, v: float) -> float:
 
 
 NO_EXTRA_FORCE = (0.0, 1.0, 0.0, 0.0)
+
+
+@compiled
+def undeclared_forces(ef, x):
+    """:func:`undeclared_force` along sampled positions ``x`` [m]."""
+    out = np.empty(len(x))
+    for k in range(len(x)):
+        out[k] = undeclared_force(ef, x[k], 0.0)
+    return out
 
 
 @compiled

@@ -141,7 +141,7 @@ def balance(pr: Prepared, p: dict, active) -> Balance:
     """Evaluate the force balance of :mod:`effects` with parameters ``p``."""
     rec = pr.rec
     if any(fx.EFFECTS[e].acts_on == 'input' for e in active):
-        u = fx.input_effects(pr.t_full, pr.u_full, p, active)
+        u = fx.effective_input(pr.t_full, pr.u_full, p, active)
         uf_full = sosfiltfilt(pr.sos, u)
     else:
         uf_full = pr.uf_full
@@ -412,3 +412,15 @@ def identify_steady(plant, volts, vels, breakaway_volts) -> dict:
             'breakaway_rms_N': float(np.sqrt(np.mean(r[len(v):] ** 2))),
             'residual_velocity_correlation': float(np.corrcoef(rs, v)[0, 1]),
             'residual_curvature_N': float(np.polyfit(v, rs, 2)[0] * np.ptp(v) ** 2 / 4)}
+
+
+def model_vectors(rec: Record, p: dict, active):
+    """The fitted force balance as the physics' arguments (:class:`ident.model.ModelVectors`), for
+    its simulation error: mass, drive gain and back-EMF as the plant, no pendulum."""
+    from .model import ModelVectors
+    amp, phase = (math.hypot(p['cog_a'], p['cog_b']), math.atan2(p['cog_b'], p['cog_a'])) if 'cogging' in active \
+        else (0.0, 0.0)
+    return ModelVectors((p['mass'], 0.0, 1.0, 9.8, rec.gain, rec.back_emf), fx.friction_vector(p, active),
+                        (amp, p.get('cog_period', 1.0), phase, p.get('F0', 0.0)), p.get('dz', 0.0) * ('deadzone' in active),
+                        p.get('u_max', 0.0) * ('saturation' in active), p.get('gap', 0.0) * ('backlash' in active),
+                        p.get('theta_bias', 0.0), p.get('delay', 0.0) * ('delay' in active))

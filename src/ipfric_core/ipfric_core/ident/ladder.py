@@ -1,0 +1,333 @@
+"""Identification as a ladder of hypotheses, judged by simulation error.
+
+The declared model (plant constants and friction law with their values) is the
+hypothesis. The ladder, on one metric (the multiple-shooting simulation error of
+:mod:`ipfric_core.ident.shooting`, in encoder counts):
+
+(a) the declared model as it is;
+(b) its friction refitted (known constants frozen unless freed by name); a large change of a
+    declared value is reported as evidence of a missing effect;
+(c) effects of the library added one at a time, each round the one that lowers the
+    validation error most among those that pass every check:
+
+- it lowers the validation simulation error by more than ``SIM_GAIN_PERCENT``, significantly
+  (block bootstrap over the validation windows, p < ``P_VALUE``), and the estimation error
+  too, and no reported figure (cart, angle) gets worse by more than ``WORSE_PERCENT``;
+- no fitted parameter ends on a bound;
+- the data do not contradict it: a deadzone below the smallest command that moved the
+  cart, a saturation that no steady speed above it refutes, a delay no longer than the
+  lag at which the cart answers the command.
+
+Fits are bounded least squares (``scipy.optimize.least_squares``) on parameters scaled to
+their typical size, with a finite-difference Jacobian; standard errors come from it,
+inflated for the correlation of the errors within a window (the effective sample count is
+the number of windows).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from ..physics.params import ConfigError
+from . import shooting
+from .effects import EFFECTS
+from .equation_error import BOOTSTRAP, P_VALUE
+from .model import LADDER_EFFECTS, Model
+from .records import Record
+
+SIM_GAIN_PERCENT = 2.0
+WORSE_PERCENT = 2.0
+MAX_ROUNDS = 3
+MAX_NFEV = 40
+DIFF_STEP = 5e-3
+THETA_WEIGHT = 0.5       # angle counts weigh half a cart count (the pendulum's own start errors grow)
+PRIOR_REL = 0.5         # the declared values' prior standard deviation, relative
+PRIOR_COUNTS = 0.3      # RMS error [counts] that one prior standard deviation is worth
+REFIT_NOTE = 0.3         # a refit that moves a declared value by more than 30 % is reported
+STOP_S = 0.05            # a stretch this long with the encoder still is a stop [s]
+SCREEN_GAIN = 0.01       # an effect whose own parameters lower the estimation cost less is not refitted
+
+#: typical size of each parameter (the fit works on value / size)
+TYPICAL = {'M': 0.5, 'm': 0.1, 'l': 0.1, 'alpha': 1.0, 'beta': 5.0, 'Fc': 0.3, 'Fs_excess': 0.3, 'eps': 2.0,
+           'v_s': 0.05, 'dz': 0.1, 'u_max': 5.0, 'delay': 0.01, 'cog_a': 0.1, 'cog_b': 0.1, 'cog_period': 0.01,
+           'asym': 0.2, 'asym_v': 1.0, 'F0': 0.1, 'theta_bias': 0.005, 'gap': 1e-3}
+
+
+class Problem:
+    """A record cut into windows, and the simulation error of a model on it: the cart's
+    readings on :func:`shooting.cart_windows`, with a pendulum also its angle on
+    :func:`shooting.angle_windows` (weighted THETA_WEIGHT)."""
+
+    def __init__(self, rec: Record):
+        self.rec = rec
+        self.blocks = [('x', shooting.cart_windows(rec), 1.0)]
+        if rec.theta is not None:
+            self.blocks.append(('theta', shooting.angle_windows(rec), THETA_WEIGHT))
+        n = len(self.blocks[0][1])
+        if n < 3:
+            raise ConfigError(f'{rec.name}: only {n} windows of valid samples; the record is too short or too '
+                              f'broken by overruns (at least 3 are needed)')
+        self.n_windows = sum(len(w) for _, w, _ in self.blocks)
+        self.n_samples = int(sum(np.sum(w.stop - w.start) for _, w, _ in self.blocks))
+
+    def predictions(self, model: Model) -> list:
+        vec = model.vectors()
+        return [shooting.predict(vec, self.rec, win) for _, win, _ in self.blocks]
+
+    def residuals(self, model: Model) -> np.ndarray:
+        return np.concatenate([wt * shooting.reading_errors(p, self.rec, key)
+                               for (key, _, wt), p in zip(self.blocks, self.predictions(model))])
+
+    def cost(self, model: Model) -> float:
+        """Mean squared simulation error [counts^2]."""
+        return float(np.mean(self.residuals(model) ** 2))
+
+    def summary(self, model: Model) -> dict:
+        out = {}
+        for (key, win, _), p in zip(self.blocks, self.predictions(model)):
+            out.update(shooting.summary(p, self.rec, win, key))
+        return out
+
+    def window_sse(self, model: Model) -> np.ndarray:
+        return np.concatenate([wt ** 2 * shooting.window_sse(p, self.rec, win, key)
+                               for (key, win, wt), p in zip(self.blocks, self.predictions(model))])
+
+
+def fit_model(pr: Problem, model: Model, max_nfev: int = MAX_NFEV, only=None, prior: Model | None = None
+        ) -> tuple[Model, dict]:
+    """Bounded least squares of the free parameters (or of those in ``only``); returns the
+    fitted model and the standard errors of the fitted parameters.
+
+    ``prior``: the declared model; each of its free values enters as a prior (standard
+    deviation PRIOR_REL of its size; one standard deviation costs as much as PRIOR_COUNTS of
+    RMS error on every compared sample), so that a direction the data hardly determine
+    (Coulomb level against viscous slope at the low speeds of a limit cycle) stays at the
+    declared value instead of wandering to a bound."""
+    free = [p for p in model.free if only is None or p.name in only]
+    if not free:
+        return model, {}
+    scale = np.array([max(abs(p.value), TYPICAL.get(p.name, 1.0)) for p in free])
+    lo = np.array([p.lo for p in free]) / scale
+    hi = np.array([p.hi for p in free]) / scale
+    x0 = np.clip(np.array([p.value for p in free]) / scale, lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
+    names = [p.name for p in free]
+    ref = {p.name: p.value for p in prior.params} if prior is not None else {}
+    anchored = [i for i, nm in enumerate(names) if nm in ref]
+    z0 = np.array([ref[names[i]] for i in anchored]) / scale[anchored] if anchored else np.zeros(0)
+    sd = PRIOR_REL * np.maximum(np.abs(z0), np.array([TYPICAL.get(names[i], 1.0) for i in anchored]) / scale[anchored])
+    weight = PRIOR_COUNTS * math.sqrt(pr.n_samples)
+
+    def fun(z):
+        r = pr.residuals(model.with_values(dict(zip(names, z * scale))))
+        return np.concatenate([r, weight * (z[anchored] - z0) / sd]) if anchored else r
+    sol = least_squares(fun, x0, bounds=(lo, hi), diff_step=DIFF_STEP, max_nfev=max_nfev, method='trf')
+    fitted = model.with_values(dict(zip(names, sol.x * scale)))
+    n = len(sol.fun)
+    inflation = n / max(1, pr.n_windows)      # errors within a window are correlated
+    try:
+        J = sol.jac / scale
+        cov = np.linalg.pinv(J.T @ J) * float(sol.fun @ sol.fun) / max(1, n - len(names)) * inflation
+        std = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    except np.linalg.LinAlgError:
+        std = np.full(len(names), np.nan)
+    return fitted, dict(zip(names, map(float, std)))
+
+
+def block_p_value(before: np.ndarray, after: np.ndarray) -> float:
+    """p-value that the squared error did not drop: bootstrap of the windows' drops."""
+    d = before - after
+    if not np.any(d):
+        return 1.0
+    rng = np.random.default_rng(0)
+    boot = d[rng.integers(0, len(d), (BOOTSTRAP, len(d)))].sum(axis=1)
+    return float((np.sum(boot <= 0.0) + 1) / (BOOTSTRAP + 1))
+
+
+# ----------------------------------------------------------------- what the data say directly
+def stops_and_starts(rec: Record) -> list[tuple[int, int]]:
+    """(last still sample, first moving sample) of every breakaway after a stop of STOP_S."""
+    x, t = rec.x, rec.t
+    moves = np.flatnonzero(np.diff(x) != 0.0)
+    out = []
+    for a, b in zip(moves[:-1], moves[1:]):
+        if t[b] - t[a + 1] >= STOP_S:
+            out.append((int(b), int(b) + 1))
+    return out
+
+
+def smallest_moving_command(rec: Record) -> float | None:
+    """The command that moved the cart from rest [V]: the largest |command| over the 5 ms before
+    each breakaway, its 10th percentile over the breakaways. A deadzone must be below it (a
+    larger one would have kept the cart still)."""
+    vals = []
+    for still, _ in stops_and_starts(rec):
+        lo = np.searchsorted(rec.t, rec.t[still] - 0.005)
+        vals.append(float(np.max(np.abs(rec.u[lo:still + 1]))))
+    return float(np.quantile(vals, 0.1)) if len(vals) >= 3 else None
+
+
+def steady_speeds(rec: Record, hold_s: float = 0.3) -> list[tuple[float, float]]:
+    """(|command| [V], |speed| [m/s]) at the end of every stretch the command stayed constant
+    for ``hold_s``: a saturation at u_max is refuted by speeds still growing above it."""
+    u, t = rec.u, rec.t
+    change = np.flatnonzero(np.diff(u) != 0.0)
+    bounds = np.concatenate([[0], change + 1, [len(u)]])
+    out = []
+    for a, b in zip(bounds[:-1], bounds[1:]):
+        if t[b - 1] - t[a] >= hold_s and u[a] != 0.0:
+            k = np.searchsorted(t, t[b - 1] - 0.1)
+            if b - 1 > k:
+                out.append((abs(float(u[a])), abs(float((rec.x[b - 1] - rec.x[k]) / (t[b - 1] - t[k])))))
+    return out
+
+
+def response_lag(rec: Record, max_lag: float = 0.1) -> float:
+    """Lag [s] at which changes of the cart's acceleration follow changes of the command best (a
+    step of the force is a step of the acceleration): a transport delay longer than it (plus
+    two samples) is not in the data."""
+    v = shooting.rates(rec.t, rec.x, rec.valid_mask)
+    du, da = np.diff(rec.u), np.diff(np.gradient(v, rec.t))
+    n = int(max_lag / rec.dt)
+    cc = [float(np.dot(du[:len(du) - k], da[k:])) for k in range(n)]
+    return int(np.argmax(cc)) * rec.dt
+
+
+def contradictions(pr: Problem, model: Model, name: str) -> list[str]:
+    """Why the data refute the fitted effect ``name`` (empty when nothing does)."""
+    rec = pr.rec
+    why = [f'{p.name} = {p.value:.4g} {p.unit} ends on its bound [{p.lo:g}, {p.hi:g}]'
+           for p in model.params if p.free and p.at_bound(1e-3 * TYPICAL.get(p.name, 1.0)) and p.name in {s.name for s in EFFECTS[name].params}]
+    if name == 'deadzone':
+        low = smallest_moving_command(rec)
+        if low is not None and model['dz'] >= low:
+            why.append(f'deadzone {model["dz"]:.3g} V is not below {low:.3g} V, a command that moved the cart')
+    if name == 'saturation':
+        share = float(np.mean(np.abs(rec.u) > model['u_max']))
+        if share < 0.01:
+            why.append(f'saturation at {model["u_max"]:.3g} V clips {100 * share:.2g} % of the commands (needs 1 %)')
+        above = sorted((u, s) for u, s in steady_speeds(rec) if u > model['u_max'])
+        if len(above) >= 2 and above[-1][1] > 1.05 * above[0][1] and above[-1][0] > 1.05 * above[0][0]:
+            why.append(f'saturation at {model["u_max"]:.3g} V, but the steady speed still grew from '
+                       f'{above[0][1]:.3g} m/s at {above[0][0]:.3g} V to {above[-1][1]:.3g} m/s at {above[-1][0]:.3g} V')
+    if name == 'delay':
+        lag = response_lag(rec)
+        if model['delay'] > lag + 2 * rec.dt:
+            why.append(f'delay {model["delay"] * 1e3:.3g} ms exceeds the lag at which the cart answers the '
+                       f'command ({lag * 1e3:.3g} ms)')
+    if name == 'cogging' and np.ptp(rec.x) < 3 * model['cog_period']:
+        why.append(f'cogging period {model["cog_period"] * 1e3:.3g} mm: fewer than 3 periods over the travel '
+                   f'({np.ptp(rec.x) * 1e3:.3g} mm)')
+    if name == 'backlash' and model['gap'] < 2 * rec.x_resolution:
+        why.append(f'play {model["gap"] * 1e3:.3g} mm is below two encoder counts (quantization)')
+    return why
+
+
+def effect_starts(pr: Problem, model: Model, name: str) -> list[dict]:
+    """Start values of effect ``name`` (several where the fit has several minima)."""
+    rec = pr.rec
+    if name == 'cogging':
+        return [{'cog_period': p} for p in (0.002, 0.0035, 0.006, 0.01, 0.015, 0.02)]
+    if name == 'delay':
+        return [{'delay': d} for d in sorted({0.003, 0.01, 0.02, round(response_lag(rec), 4) or 0.001})]
+    if name == 'deadzone':
+        low = smallest_moving_command(rec) or 0.5
+        return [{'dz': f * low} for f in (0.2, 0.5)]
+    if name == 'saturation':
+        umax = float(np.max(np.abs(rec.u)))
+        return [{'u_max': f * umax} for f in (0.5, 0.8)]
+    if name == 'backlash':
+        return [{'gap': g} for g in (3e-4, 1e-3, 3e-3)]
+    if name == 'sensor_bias':
+        return [{'theta_bias': float(np.mean(rec.theta))}]
+    return [{}]
+
+
+def candidate(pe: Problem, current: Model, name: str, prior: Model) -> tuple[Model, dict]:
+    """The best fit of ``current`` + ``name`` over its starts: a short fit of the effect's own
+    parameters with the friction levels (an effect the refit absorbed into them, a deadzone into
+    the Coulomb level, needs them free to show) from each start, then a full one from the best."""
+    own = {s.name for s in EFFECTS[name].params}
+    levels = {p.name for p in current.free} & {'Fc', 'Fs_excess'}
+    screen = (own - {'cog_period'}) | levels
+    best = None
+    for s in effect_starts(pe, current, name):
+        m, _ = fit_model(pe, current.with_effect(name, s), max_nfev=12, only=screen, prior=prior)
+        c = pe.cost(m)
+        if best is None or c < best[0]:
+            best = (c, m)
+    if best[0] > (1 - SCREEN_GAIN) * pe.cost(current):
+        return best[1], {}   # explains nothing even with the levels free: not worth a full fit
+    joint = own | ({p.name for p in current.free} & {'Fc', 'Fs_excess', 'eps'})
+    return fit_model(pe, best[1], only=joint, prior=prior)
+
+
+@dataclass
+class Step:
+    label: str
+    model: Model
+    std: dict
+    est: dict
+    val: dict
+    notes: list
+
+
+def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress=None) -> dict:
+    """The ladder on ``est`` (fits) and ``val`` (judgement); see the module docstring."""
+    say = progress or (lambda msg: None)
+    pe, pv = Problem(est), Problem(val)
+    steps = [Step('declared', declared, {}, pe.summary(declared), pv.summary(declared), [])]
+    say(f'declared model: validation x error {steps[0].val["x_rms_counts"]:.3g} counts')
+    refit, std = fit_model(pe, declared, max_nfev=60, prior=declared)
+    notes = []
+    for p in refit.free:
+        old = declared.param(p.name).value
+        if abs(p.value - old) > REFIT_NOTE * max(abs(old), TYPICAL.get(p.name, 1.0)):
+            notes.append(f'{p.name} refitted from {old:.4g} to {p.value:.4g} {p.unit} '
+                         f'({100 * (p.value - old) / (abs(old) or 1):+.0f} %): the declared model misses something')
+        if p.at_bound(1e-3 * TYPICAL.get(p.name, 1.0)):
+            notes.append(f'{p.name} = {p.value:.4g} {p.unit} ends on its bound [{p.lo:g}, {p.hi:g}]: the data '
+                         f'contradict the declared law there')
+    steps.append(Step('refit', refit, std, pe.summary(refit), pv.summary(refit), notes))
+    say(f'refit: validation x error {steps[-1].val["x_rms_counts"]:.3g} counts')
+    current, tried = refit, []
+    for _ in range(MAX_ROUNDS):
+        sse0_v = pv.window_sse(current)
+        ranked = []
+        for name in LADDER_EFFECTS:
+            if name in current.effects or (allowed is not None and name not in allowed):
+                continue
+            if EFFECTS[name].needs_theta and est.theta is None:
+                continue
+            m, s = candidate(pe, current, name, declared)
+            ev0, ev1 = pv.cost(current), pv.cost(m)
+            ee0, ee1 = pe.cost(current), pe.cost(m)
+            gain = 100 * (1 - math.sqrt(ev1 / ev0)) if ev0 > 0 else 0.0
+            p = block_p_value(sse0_v, pv.window_sse(m))
+            why = contradictions(pe, m, name)
+            if gain <= SIM_GAIN_PERCENT:
+                why.append(f'validation error drops by {gain:.2f} % (needs > {SIM_GAIN_PERCENT:g} %)')
+            elif p >= P_VALUE:
+                why.append(f'the drop is not significant (p = {p:.2g} over {pv.n_windows} windows)')
+            if ee1 >= ee0:
+                why.append('the estimation error does not drop')
+            before, after = pv.summary(current), pv.summary(m)
+            for key in ('x_rms_counts', 'theta_rms_counts'):
+                if key in before and after[key] > before[key] * (1 + WORSE_PERCENT / 100):
+                    why.append(f'validation {key.split("_")[0]} error rises from {before[key]:.3g} to '
+                               f'{after[key]:.3g} counts')
+            tried.append({'effect': name, 'validation_gain_percent': gain, 'p_value': p,
+                          'values': {s.name: m[s.name] for s in EFFECTS[name].params}, 'refused': why, 'kept': False})
+            say(f'  tried {name:<11} gain {gain:6.2f} %  p {p:.2g}  ' + ('; '.join(why) or 'passes'))
+            ranked.append((gain, name, m, s, why, len(tried) - 1))
+        ok = [r for r in ranked if not r[4]]
+        if not ok:
+            break
+        gain, name, m, s, _, i = max(ok, key=lambda r: r[0])
+        tried[i]['kept'] = True
+        current, s = fit_model(pe, m, max_nfev=60, prior=declared)   # every free parameter together
+        steps.append(Step(f'+ {name}', current, s, pe.summary(current), pv.summary(current), []))
+        say(f'kept {name}: validation x error {steps[-1].val["x_rms_counts"]:.3g} counts')
+    return {'steps': steps, 'tried': tried, 'estimation': est, 'validation': val}

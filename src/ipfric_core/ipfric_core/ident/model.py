@@ -1,0 +1,201 @@
+"""The model under identification: a declared plant and friction law, and the effects added.
+
+Every parameter is a :class:`Param` with a unit, physical bounds and a ``free`` flag (as
+in MuJoCo's sysid toolbox). Known constants of the plant (masses, pendulum length, motor
+alpha and beta: paper Table 1 and eq. 2) are frozen unless the user frees them by name;
+the friction of the declared law (levels in N, so the same for any normal force) and the
+parameters of each added effect are fitted. :meth:`Model.vectors` turns the values into
+the arguments of :mod:`ipfric_core.physics` (plant vector, friction vector, forces fixed
+to the track, input and sensor effects): the model that is fitted is the model the
+simulator runs, and :meth:`Model.friction_params` / :meth:`Model.plant_truth` export it
+whole (cogging phase, asymmetry, offset included).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+from ..physics.friction import parameter_vector
+from ..physics.params import ConfigError, FrictionParams, PlantParams
+from ..physics.plant import parameter_vector as plant_vector
+from ..physics.rig import PlantTruth
+from .effects import EFFECTS
+
+
+@dataclass(frozen=True)
+class Param:
+    """One parameter: value, unit, bounds, whether it is fitted, what it is."""
+
+    name: str
+    value: float
+    unit: str
+    lo: float
+    hi: float
+    free: bool = True
+    doc: str = ''
+
+    def at_bound(self, tol: float) -> bool:
+        """True when the fitted value sits within ``tol`` of a bound."""
+        return self.free and (self.value - self.lo <= tol or self.hi - self.value <= tol)
+
+
+PLANT_KNOWN = {  # name -> (unit, lo, hi, doc); frozen unless freed
+    'M': ('kg', 0.05, 50.0, 'cart mass'),
+    'm': ('kg', 0.0, 10.0, 'pendulum mass'),
+    'l': ('m', 0.01, 2.0, 'pivot to pendulum centre of mass'),
+    'alpha': ('N/V', 0.01, 100.0, 'motor force per volt, eq. (2)'),
+    'beta': ('N s/m', 0.0, 200.0, 'motor back-EMF damping, eq. (2)'),
+}
+FRICTION_FITTED = {  # name -> (unit, lo, hi, doc), per declared law
+    'Fc': ('N', 0.0, 50.0, 'Coulomb level mu_c F_N, eq. (6)'),
+    'Fs_excess': ('N', 0.0, 50.0, 'static minus Coulomb level (mu_s - mu_c) F_N, eq. (5)'),
+    'eps': ('N s/m', 0.0, 200.0, 'viscous coefficient, eq. (3)'),
+    'v_s': ('m/s', 1e-3, 2.0, 'Stribeck velocity, eq. (8)'),
+}
+LAW_PARAMS = {'viscous': ('eps',), 'coulomb': ('Fc', 'Fs_excess', 'eps'),
+              'exponential': ('Fc', 'Fs_excess', 'eps', 'v_s')}
+
+#: Effects the ladder adds, from the one library of :mod:`ipfric_core.ident.effects` (the base
+#: law's coulomb, stribeck and presliding are the declared friction here).
+LADDER_EFFECTS = ('deadzone', 'saturation', 'delay', 'cogging', 'asymmetry', 'offset', 'sensor_bias', 'backlash')
+
+
+@dataclass(frozen=True)
+class ModelVectors:
+    """The arguments of the physics functions for one set of parameter values."""
+
+    pp: tuple
+    fp: tuple
+    ef: tuple
+    deadzone: float
+    saturation: float
+    gap: float
+    theta_bias: float
+    delay: float
+
+
+@dataclass(frozen=True)
+class Model:
+    """A declared plant and friction law plus added effects, with every parameter."""
+
+    law: str                       # viscous, coulomb or exponential (declared)
+    params: tuple                  # Param, in order
+    effects: tuple = ()            # names of EFFECTS added, in order
+    gamma: float = 2.0             # Stribeck form factor (declared, not fitted)
+    g: float = 9.8
+    normal_force: float = 1.0      # F_N [N] of the friction coefficients mu
+    pendulum: bool = True          # the pendulum is attached (else m is taken as 0)
+
+    def __getitem__(self, name: str) -> float:
+        return self.param(name).value
+
+    def param(self, name: str) -> Param:
+        for p in self.params:
+            if p.name == name:
+                return p
+        raise KeyError(name)
+
+    def get(self, name: str, default: float = 0.0) -> float:
+        return self[name] if any(p.name == name for p in self.params) else default
+
+    @property
+    def free(self) -> list[Param]:
+        return [p for p in self.params if p.free]
+
+    def with_values(self, values: dict) -> 'Model':
+        return replace(self, params=tuple(replace(p, value=float(values[p.name])) if p.name in values else p
+                                          for p in self.params))
+
+    def with_effect(self, name: str, starts: dict | None = None) -> 'Model':
+        """This model with effect ``name`` added (its parameters free, at ``starts`` or defaults)."""
+        e = EFFECTS[name]
+        new = tuple(Param(s.name, float((starts or {}).get(s.name, s.init or 0.0)), s.unit, s.lo, s.hi, True, e.doc)
+                    for s in e.params)
+        return replace(self, params=self.params + new, effects=self.effects + (name,))
+
+    def freeing(self, names) -> 'Model':
+        """Known constants ``names`` fitted too (a refit of a known constant tests the model)."""
+        bad = [n for n in names if n not in PLANT_KNOWN]
+        if bad:
+            raise ConfigError(f'--free: {", ".join(bad)} is not a plant constant; allowed: {", ".join(PLANT_KNOWN)}')
+        return replace(self, params=tuple(replace(p, free=True) if p.name in names else p for p in self.params))
+
+    def friction_params(self) -> FrictionParams:
+        """The friction law with its fitted values as coefficients (F_N = normal_force)."""
+        fn = self.normal_force
+        fc = self.get('Fc')
+        return FrictionParams(model=self.law, eps=self['eps'], mu_c=fc / fn,
+                              mu_s=(fc + self.get('Fs_excess')) / fn, v_s=self.get('v_s', 0.105),
+                              gamma=self.gamma, asymmetry=self.get('asym'),
+                              asymmetry_viscous=self.get('asym_v'))
+
+    def plant_params(self) -> PlantParams:
+        return PlantParams(M=self['M'], m=max(self['m'], 1e-6), l=self['l'], g=self.g,
+                           alpha=self['alpha'], beta=self['beta'])
+
+    def cogging(self) -> tuple[float, float, float]:
+        """(A [N], P [m], phi [rad]) of A sin(2 pi x / P + phi)."""
+        a, b = self.get('cog_a'), self.get('cog_b')
+        return math.hypot(a, b), self.get('cog_period', 0.01), math.atan2(b, a)
+
+    def plant_truth(self, dt: float) -> PlantTruth:
+        """The added effects as the simulator's ``plant_truth`` (delay rounded to samples)."""
+        amp, period, phase = self.cogging()
+        return PlantTruth(cogging_N=amp, cogging_period_m=period, cogging_phase_rad=phase,
+                          offset_N=self.get('F0'), deadzone_V=self.get('dz'), saturation_V=self.get('u_max'),
+                          input_delay_s=round(self.get('delay') / dt) * dt, backlash_m=self.get('gap'),
+                          bias_theta_rad=self.get('theta_bias'))
+
+    def vectors(self) -> ModelVectors:
+        pp = list(plant_vector(self.plant_params()))
+        if not self.pendulum:
+            pp[1] = 0.0
+        amp, period, phase = self.cogging()
+        return ModelVectors(tuple(pp), parameter_vector(self.friction_params(), self.normal_force),
+                            (amp, period, phase, self.get('F0')), self.get('dz'), self.get('u_max'),
+                            self.get('gap'), self.get('theta_bias'), self.get('delay'))
+
+
+def declared(plant: PlantParams, friction: FrictionParams, pendulum: bool) -> Model:
+    """The declared model: the plant's constants frozen, the friction law's values free."""
+    fn = plant.normal_force if pendulum else plant.M * plant.g
+    if friction.model not in LAW_PARAMS:
+        raise ConfigError(f'friction.model: {friction.model!r} cannot be identified; allowed: '
+                          f'{", ".join(LAW_PARAMS)}')
+    params = [Param(k, float(getattr(plant, k)), *PLANT_KNOWN[k][:3], False, PLANT_KNOWN[k][3])
+              for k in PLANT_KNOWN]
+    values = {'Fc': friction.mu_c * fn, 'Fs_excess': (friction.mu_s - friction.mu_c) * fn,
+              'eps': friction.eps, 'v_s': friction.v_s}
+    for k in LAW_PARAMS[friction.model]:
+        unit, lo, hi, doc = FRICTION_FITTED[k]
+        params.append(Param(k, float(values[k]), unit, lo, hi, True, doc))
+    return Model(friction.model, tuple(params), (), friction.gamma, plant.g, fn, pendulum)
+
+
+def load_declared(path, law: str, pendulum: bool, plant: PlantParams | None = None) -> Model:
+    """The declared model from a file: a scenario (its sim_node plant and friction), a
+    paper-style file (plant, and friction named by law: the ``law`` entry), or a file with
+    only ``plant:`` (friction: the paper's ``law``). No file: ``plant`` (a bag's stored
+    scenario) or Table 1, and the paper's ``law`` (Table 3 for exponential)."""
+    from ..design.paperconfig import DEFAULT_CONFIG
+    from ..physics.params import check_keys, load_yaml
+    if law not in LAW_PARAMS:
+        raise ConfigError(f'--base: {law!r} is not a law the ladder fits; allowed: {", ".join(LAW_PARAMS)}')
+    paper = {name: FrictionParams.from_dict(v, f'{DEFAULT_CONFIG}: friction.{name}')
+             for name, v in load_yaml(DEFAULT_CONFIG)['friction'].items()}
+    friction = next(f for f in paper.values() if f.model == law)   # Table 2 for coulomb, Table 3 for exponential
+    if path is not None:
+        data = load_yaml(path)
+        if 'sim_node' in data:
+            from ..run.scenario import load_scenario
+            scn = load_scenario(path)
+            plant, friction = scn.plant, scn.friction
+        else:
+            check_keys(str(path), data, {'plant', 'friction', 'design'}, {'plant'})
+            plant = PlantParams.from_dict(data['plant'], f'{path}: plant')
+            fr = data.get('friction')
+            if isinstance(fr, dict) and 'model' in fr:
+                friction = FrictionParams.from_dict(fr, f'{path}: friction')
+            elif isinstance(fr, dict) and law in fr:
+                friction = FrictionParams.from_dict(fr[law], f'{path}: friction.{law}')
+    return declared(plant or PlantParams(), friction, pendulum)

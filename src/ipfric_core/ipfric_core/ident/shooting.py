@@ -1,0 +1,216 @@
+"""Simulation error by multiple shooting: the recorded command replayed through the model.
+
+The record is cut into windows. Each window starts from the measured state: encoder
+positions, at rest and held by static friction where the encoder stood still around the
+start (windows start there whenever they can: that state is known exactly), else with
+velocities from a local fit. The cart is judged on windows of ``CART_WINDOW_S``; with a
+pendulum attached its angle is taken from the measurement there (the upright pendulum is
+unstable: a small error in its initial rate would grow into the cart's motion), and the
+angle itself is judged on short windows of ``PENDULUM_WINDOW_S`` of the free coupled motion. The model (the
+plant of paper eq. (1)-(2), the friction law and the undeclared effects, all evaluated by
+:mod:`ipfric_core.physics`: :func:`~ipfric_core.physics.simulate.advance` with
+:func:`~ipfric_core.physics.rig.input_effects` and :func:`~ipfric_core.physics.rig.play`)
+is integrated over the window with each command held until the next time stamp (the
+stamps may be uneven). The error is the simulated minus the measured encoder reading, in
+encoder counts; samples the record marks invalid (sample overruns) are not compared and
+no window spans them.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+from scipy.signal import butter, sosfiltfilt
+
+from ..physics import compiled  # noqa: F401  (sets numba's cache directory)
+from ..physics.rig import input_effects, play
+from ..physics.simulate import advance
+from .records import Record
+
+CART_WINDOW_S = 1.0
+PENDULUM_WINDOW_S = 0.25
+STILL_S = 0.02       # an encoder standing still this long before and after a sample: at rest [s]
+FILTER_HZ = 25.0     # corner of the velocity estimate at window starts [Hz]
+
+
+@dataclass(frozen=True)
+class Windows:
+    """Windows [start, stop) of a record and the measured state at each start."""
+
+    start: np.ndarray     # first sample
+    stop: np.ndarray      # one past the last sample
+    state: np.ndarray     # (n, 5): x, theta, x', theta', z=0 at the start
+    held: np.ndarray      # (n,): 1.0 where the cart stood still at the start
+    forced: np.ndarray    # (n_samples, 2) measured angle and rate the simulation follows, or (0, 2)
+
+    def __len__(self) -> int:
+        return len(self.start)
+
+
+def rates(t: np.ndarray, y: np.ndarray, valid: np.ndarray) -> np.ndarray:
+    """dy/dt of an encoder signal along the record [unit/s]: zero-phase 4th-order Butterworth at
+    FILTER_HZ on a uniform grid (the record's median period), differentiated, read back at ``t``."""
+    dt = float(np.median(np.diff(t)))
+    grid = np.arange(t[0], t[-1] + 0.5 * dt, dt)
+    yg = np.interp(grid, t[valid], y[valid])
+    cutoff = min(FILTER_HZ, 0.4 / dt)
+    f = sosfiltfilt(butter(4, cutoff, fs=1.0 / dt, output='sos'), yg)
+    return np.interp(t, grid, np.gradient(f, dt))
+
+
+def local_rate(t: np.ndarray, y: np.ndarray, k: int, half_s: float = 0.01) -> float:
+    """dy/dt at sample k [unit/s]: slope of a quadratic fitted over +/- ``half_s`` (at least two
+    samples each side), which follows a quantized signal through fast changes."""
+    dt = float(np.median(np.diff(t)))
+    h = max(2, int(round(half_s / dt)))
+    lo, hi = max(0, k - h), min(len(t), k + h + 1)
+    c = np.polyfit(t[lo:hi] - t[k], y[lo:hi], 2)
+    return float(c[1])
+
+
+def still(t: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """True at samples whose encoder reading equals every reading within +/- STILL_S."""
+    same_before = np.zeros(len(x), bool)
+    moves = np.concatenate([[0], np.flatnonzero(np.diff(x) != 0.0) + 1, [len(x)]])
+    for a, b in zip(moves[:-1], moves[1:]):
+        # samples a..b-1 share one reading; inside by STILL_S from both ends
+        lo = np.searchsorted(t, t[a] + STILL_S)
+        hi = np.searchsorted(t, t[b - 1] - STILL_S, side='right')
+        same_before[lo:hi] = True
+    return same_before
+
+
+def make_windows(rec: Record, length_s: float, forced: bool = False) -> Windows:
+    """Windows of about ``length_s`` [s] over the valid stretches of ``rec``, each started where
+    the cart stands still when it can (its state is then known: at rest, held by static
+    friction), else from the measured state with velocities from :func:`local_rate`. With
+    ``forced``, the angle follows the measurement in them (its rate: :func:`rates`)."""
+    valid = rec.valid_mask
+    t, x = rec.t, rec.x
+    th = rec.theta if rec.theta is not None else np.zeros_like(x)
+    rest = still(t, x) & valid
+    starts, stops = [], []
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], valid.astype(int), [0]])))
+    for a, b in zip(edges[::2], edges[1::2]):
+        k = a
+        while k < b - 1 and t[b - 1] - t[k] >= 0.5 * length_s:
+            end = min(b, int(np.searchsorted(t, t[k] + length_s, side='right')))
+            # the next window starts at a rest within the last half of this one, if any
+            lo = int(np.searchsorted(t, t[k] + 0.5 * length_s))
+            r = np.flatnonzero(rest[lo:end])
+            if len(r) and end < b:
+                end = lo + int(r[-1]) + 1
+            starts.append(k)
+            stops.append(end)
+            k = end - 1
+    start, stop = np.array(starts, int), np.array(stops, int)
+    held = rest[start].astype(float)
+    v = np.array([0.0 if h else local_rate(t, x, k) for k, h in zip(start, held)])
+    w = (np.array([local_rate(t, th, k) for k in start]) if rec.theta is not None
+         else np.zeros(len(start)))
+    state = np.column_stack([x[start], th[start], v, w, np.zeros(len(start))])
+    angle = (np.column_stack([rec.theta, rates(t, rec.theta, valid)]) if forced else np.zeros((0, 2)))
+    return Windows(start, stop, state, held, angle)
+
+
+def cart_windows(rec: Record) -> Windows:
+    """The windows on which the cart is judged (the angle forced when a pendulum is attached)."""
+    return make_windows(rec, CART_WINDOW_S, forced=rec.theta is not None)
+
+
+def angle_windows(rec: Record) -> Windows:
+    """The short windows of free coupled motion on which the angle is judged."""
+    return make_windows(rec, PENDULUM_WINDOW_S)
+
+
+@numba.njit(cache=True, parallel=True)   # the windows are independent: one thread each
+def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, t, u, start, stop, state, held,
+           substep, forced, out):
+    """Encoder readings (x, theta) predicted in every window, written into ``out`` (n, 2).
+    Without a pendulum (pp's m = 0) the angle is held at 0; with ``forced`` (n, 2) rows, the
+    angle and its rate are set to them (less the bias) after every sample."""
+    pendulum = pp[1] > 0.0
+    force = len(forced) > 0
+    for w in numba.prange(len(start)):
+        s = (state[w, 0], state[w, 1] - theta_bias, state[w, 2], state[w, 3], state[w, 4])
+        mode = (held[w], 0.0, 0.0)
+        reading = s[0]
+        k0 = start[w]
+        out[k0, 0], out[k0, 1] = reading, s[1] + theta_bias
+        for k in range(k0, stop[w] - 1):
+            s, mode = advance(pp, fp, ef, s, mode, input_effects(u[k], deadzone, saturation),
+                              t[k + 1] - t[k], substep)
+            if force:
+                s = (s[0], forced[k + 1, 0] - theta_bias, s[2], forced[k + 1, 1], s[4])
+            elif not pendulum:
+                s = (s[0], 0.0, s[2], 0.0, s[4])
+            if not (math.isfinite(s[0]) and math.isfinite(s[1])) or abs(s[1]) > 1.5:
+                for j in range(k + 1, stop[w]):
+                    out[j, 0], out[j, 1] = np.nan, np.nan
+                break
+            reading = play(reading, s[0], gap) if gap > 0.0 else s[0]
+            out[k + 1, 0], out[k + 1, 1] = reading, s[1] + theta_bias
+
+
+def delayed(t: np.ndarray, u: np.ndarray, delay: float) -> np.ndarray:
+    """The held command seen through a transport delay [s]: the mean of u(t - delay) over each
+    sample interval, u held between stamps (exact for a zero-order hold, smooth in delay)."""
+    if delay <= 0.0:
+        return u
+    dt = np.diff(t)
+    area = np.concatenate([[0.0], np.cumsum(u[:-1] * dt)])
+    # area up to time s of the held command, u[0] before the start
+    tq = np.concatenate([t - delay, [t[-1] + dt[-1] - delay]])
+    a = np.interp(tq, t, area) + np.minimum(tq - t[0], 0.0) * u[0]
+    return np.diff(a) / np.concatenate([dt, [dt[-1]]])
+
+
+@dataclass(frozen=True)
+class Prediction:
+    """Simulated encoder readings and their error against the measured ones."""
+
+    x: np.ndarray            # simulated cart reading [m]
+    theta: np.ndarray | None
+    compared: np.ndarray     # samples compared (valid, inside a window, not its first)
+    window_of: np.ndarray    # window index of each sample (-1 outside)
+
+
+def predict(model, rec: Record, win: Windows) -> Prediction:
+    """Replay ``rec``'s command through ``model`` (an :class:`ident.model.ModelVectors`)."""
+    u = delayed(rec.t, rec.u, model.delay)
+    out = np.full((len(rec.t), 2), np.nan)
+    _shoot(model.pp, model.fp, model.ef, model.deadzone, model.saturation, model.gap, model.theta_bias,
+           rec.t, np.ascontiguousarray(u, float), win.start, win.stop, win.state, win.held,
+           min(1e-3, float(np.median(np.diff(rec.t)))), win.forced, out)
+    window_of = np.full(len(rec.t), -1)
+    for i, (a, b) in enumerate(zip(win.start, win.stop)):
+        window_of[a + 1:b] = i
+    compared = (window_of >= 0) & rec.valid_mask
+    return Prediction(out[:, 0], out[:, 1] if rec.theta is not None else None, compared, window_of)
+
+
+def reading_errors(pred: Prediction, rec: Record, key: str) -> np.ndarray:
+    """Simulated minus measured reading of ``key`` ('x' or 'theta') in encoder counts, on the
+    compared samples (a diverged simulation counts 1e4 counts)."""
+    c = pred.compared
+    sim, meas, res = ((pred.x, rec.x, rec.x_resolution) if key == 'x'
+                      else (pred.theta, rec.theta, rec.theta_resolution))
+    e = (sim[c] - meas[c]) / res
+    return np.where(np.isfinite(e), e, 1e4)
+
+
+def summary(pred: Prediction, rec: Record, win: Windows, key: str) -> dict:
+    """RMS error of ``key`` in counts and in percent of the motion within the windows."""
+    c = pred.compared
+    e = reading_errors(pred, rec, key)
+    meas, res = (rec.x, rec.x_resolution) if key == 'x' else (rec.theta, rec.theta_resolution)
+    motion = (meas[c] - meas[win.start[pred.window_of[c]]]) / res
+    return {f'{key}_windows': len(win), f'{key}_rms_counts': float(np.sqrt(np.mean(e ** 2))),
+            f'{key}_percent': float(100 * np.linalg.norm(e) / max(np.linalg.norm(motion), 1.0))}
+
+
+def window_sse(pred: Prediction, rec: Record, win: Windows, key: str) -> np.ndarray:
+    """Sum of squared errors [counts^2] of each window (the unit of the significance test)."""
+    return np.bincount(pred.window_of[pred.compared], reading_errors(pred, rec, key) ** 2, len(win))

@@ -1,0 +1,105 @@
+"""Identification on data ipfric did not make: the independent rig simulator of
+tests/independent (its own integrator and effect formulas, the paper's plant and Table-3
+friction with true stick-slip, encoder quantization), one undeclared effect per file, the
+same command for every file, and a second rig with other constants, 5 ms sampling, sample
+overruns and an angle measured from hanging.
+
+Each case asserts the effect kept (nothing on the clean files), its parameters against the
+truth, that no fitted parameter ends on a bound, and that the simulation error falls.
+"""
+import json
+import math
+
+import pytest
+
+from ipfric_core.cli import main
+from ipfric_core.ident.ladder import TYPICAL, run_ladder
+from ipfric_core.ident.model import load_declared
+from ipfric_core.ident.records import load
+from independent import rigsim
+
+CART_S, LOOP_S = 45.0, 20.0
+
+
+def cogging_amplitude(p):
+    return math.hypot(p['cog_a'], p['cog_b'])
+
+
+# case, effects kept, {parameter: (true value, absolute tolerance)}
+CASES = [
+    ('cart_none', (), {'Fc': (0.3425, 0.02), 'eps': (3.0, 0.2)}),
+    ('cart_deadzone', ('deadzone',), {'dz': (0.3, 0.03)}),
+    ('cart_cogging', ('cogging',), {'cog_period': (0.010, 0.0005), cogging_amplitude: (0.3, 0.05)}),
+    ('cart_asymmetry', ('asymmetry',), {'asym': (0.4, 0.05)}),
+    ('cart_delay', ('delay',), {'delay': (0.010, 0.003)}),
+    ('cart_backlash', ('backlash',), {'gap': (0.001, 0.0012)}),
+    ('loop_none', (), {}),
+    ('loop_deadzone', ('deadzone',), {'dz': (0.3, 0.06)}),
+    ('loop_cogging', ('cogging',), {'cog_period': (0.010, 0.001), cogging_amplitude: (0.3, 0.08)}),
+    ('loop_asymmetry', ('asymmetry',), {'asym': (0.4, 0.1)}),
+    ('loop_delay', ('delay',), {'delay': (0.010, 0.004)}),
+    ('loop_bias', ('sensor_bias',), {'theta_bias': (0.005, 0.002)}),
+]
+
+
+@pytest.fixture(scope='module')
+def data(tmp_path_factory):
+    """Every case written once as a CSV by the independent simulator."""
+    out = tmp_path_factory.mktemp('independent')
+    paths = {}
+    for name, *_ in CASES + [('ip02_cart',), ('ip02_loop_hanging',)]:
+        duration = CART_S if 'cart' in name else LOOP_S
+        paths[name] = rigsim.write_case(name, out, duration=duration)
+    return paths
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize('case, kept, expect', CASES, ids=[c[0] for c in CASES])
+def test_undeclared_effect_in_independent_data(data, case, kept, expect):
+    rec = load(data[case], None)
+    est, val = rec.split(0.6)
+    res = run_ladder(est, val, load_declared(None, 'exponential', rec.theta is not None))
+    final = res['steps'][-1].model
+    assert final.effects == kept, res['tried']
+    for key, (value, tol) in expect.items():
+        got = key(final) if callable(key) else final[key]
+        assert got == pytest.approx(value, abs=tol), key
+    assert not [p.name for p in final.params if p.at_bound(1e-3 * TYPICAL.get(p.name, 1.0))]
+    errors = [s.val['x_rms_counts'] for s in res['steps']]
+    assert errors[-1] <= errors[1] * 1.02          # the ladder never ends worse than the refit
+    if kept:
+        assert errors[-1] < 0.8 * errors[1]       # and the effect explains what the refit could not
+
+
+@pytest.mark.slow
+def test_other_rig_with_overruns_and_5ms_sampling_stays_plausible(data, tmp_path, capsys):
+    """ip02: lighter cart, other motor; its plant file declares only the plant (the paper's
+    friction is the hypothesis). The refit friction is that rig's, nothing is added, the
+    overruns are counted and left out."""
+    plant = tmp_path / 'ip02.yaml'
+    rig = rigsim.RIGS['ip02']
+    plant.write_text('plant: {' + ', '.join(f'{k}: {rig[k]}' for k in ('M', 'm', 'l', 'g', 'alpha', 'beta')) + '}\n')
+    assert main(['identify', str(data['ip02_cart']), '--plant', str(plant), '--out', str(tmp_path / 'cart'),
+                 '--json']) == 0
+    r = json.loads(capsys.readouterr().out)
+    assert any('sample overruns' in n for n in r['data']['notes'])
+    assert r['data']['sample_period_s'] == pytest.approx(0.005, rel=0.01)
+    assert r['effects_added'] == []
+    refit = {p['name']: p for p in r['ladder'][1]['params']}
+    fn = rig['M'] * rig['g']
+    assert refit['Fc']['value'] == pytest.approx(rig['mu_c'] * fn, rel=0.15)
+    assert refit['Fc']['value'] + refit['Fs_excess']['value'] == pytest.approx(rig['mu_s'] * fn, rel=0.15)
+    assert refit['eps']['value'] == pytest.approx(rig['eps'], rel=0.25)
+    assert refit['M']['value'] == rig['M'] and not refit['M']['fitted']
+    assert not any(p['at_bound'] for p in r['ladder'][-1]['params'])
+    assert r['ladder'][1]['validation']['x_rms_counts'] < 0.5 * r['ladder'][0]['validation']['x_rms_counts']
+    for name in ('report.md', 'ladder.png', 'windows.png'):
+        assert (tmp_path / 'cart' / name).stat().st_size > 0
+    assert main(['identify', str(data['ip02_loop_hanging']), '--plant', str(plant), '--out',
+                 str(tmp_path / 'loop'), '--json', '--no-plots']) == 0
+    r = json.loads(capsys.readouterr().out)
+    assert any('hanging' in n for n in r['data']['notes'])
+    assert 'sensor_bias' not in r['effects_added']
+    assert not any(p['at_bound'] for p in r['ladder'][-1]['params'])
+    dz = [t for t in r['effects_tried'] if t['effect'] == 'deadzone']
+    assert not dz or not dz[0]['kept'] or dz[0]['values']['dz'] < 0.5

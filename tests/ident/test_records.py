@@ -1,0 +1,90 @@
+"""Data as rigs write them: what the loaders take (uneven stamps, overruns, wrapped and
+hanging angles, a byte-order mark, gzip) and what they refuse, by name, with exit code 2."""
+import gzip
+
+import numpy as np
+import pytest
+
+from ipfric_core.cli import main
+from ipfric_core.ident.records import load, overruns, upright_angle
+from ipfric_core.physics.params import ConfigError
+
+N = 600
+
+
+def table(theta=None, t=None, x=None, u=None):
+    t = np.arange(N) * 1e-3 if t is None else t
+    x = np.round(0.01 * np.sin(2 * np.pi * t) / 4.54e-5) * 4.54e-5 if x is None else x
+    u = np.sin(2 * np.pi * 3 * t) if u is None else u
+    cols = [t, x, u] + ([theta] if theta is not None else [])
+    head = 't,x,voltage' + (',theta' if theta is not None else '')
+    return head + '\n' + '\n'.join(','.join(f'{v:.9g}' for v in row) for row in zip(*cols)) + '\n'
+
+
+GOOD = table()
+ROWS = GOOD.splitlines()
+# name, file name, content (str or bytes), phrase of the message
+REFUSED = [
+    ('all-zero voltage', 'zero.csv', table(u=np.zeros(N)), 'voltage is 0 throughout'),
+    ('binary file', 'bin.csv', bytes(range(256)) * 8, 'not a text (UTF-8) CSV'),
+    ('empty', 'empty.csv', '', 'empty file'),
+    ('header only', 'head.csv', 't,x,voltage\n', 'a header and no data rows'),
+    ('ragged row', 'ragged.csv', '\n'.join(ROWS[:50] + [ROWS[50] + ',7'] + ROWS[51:]) + '\n', 'row 51 has 4 fields'),
+    ('text in a number', 'word.csv', '\n'.join(ROWS[:9] + ['0.008,abc,1'] + ROWS[10:]) + '\n',
+     "row 10, column 'x': 'abc' is not a number"),
+    ('time in ms', 'ms.csv', table(t=np.arange(N) * 1.0), 'is t in ms'),
+    ('1e308 volts', 'huge.csv', '\n'.join(ROWS[:99] + ['0.098,0,1e308'] + ROWS[100:]) + '\n',
+     'column voltage is 1e+308 at row 99'),
+    ('random .mat', 'rand.mat', bytes(np.random.default_rng(0).integers(0, 256, 4000, dtype=np.uint8)),
+     'not a readable MATLAB file'),
+    ('empty .mat', 'empty.mat', b'', 'not a readable MATLAB file'),
+    ('angle in degrees', 'deg.csv', table(theta=np.full(N, 15.0)), 'degrees?'),
+    ('no such file', 'missing.csv', None, 'cannot read'),
+]
+
+
+@pytest.mark.parametrize('name, fname, content, phrase', REFUSED, ids=[r[0] for r in REFUSED])
+def test_bad_data_refused_by_name_with_exit_2(tmp_path, capsys, name, fname, content, phrase):
+    path = tmp_path / fname
+    if content is not None:
+        path.write_bytes(content if isinstance(content, bytes) else content.encode())
+    before = sorted(p.name for p in tmp_path.iterdir())
+    assert main(['identify', str(path), '--out', str(tmp_path / 'out'), '--no-plots']) == 2
+    err = capsys.readouterr().err
+    assert phrase in err, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == before     # nothing written, nothing lost
+
+
+def test_bom_gzip_and_column_mapping_are_read(tmp_path):
+    (tmp_path / 'bom.csv').write_bytes(b'\xef\xbb\xbf' + GOOD.encode())
+    with gzip.open(tmp_path / 'log.csv.gz', 'wt') as f:
+        f.write(GOOD.replace('t,x,voltage', 'time,cart,u', 1))
+    a = load(tmp_path / 'bom.csv', None)
+    b = load(tmp_path / 'log.csv.gz', None, {'t': 'time', 'x': 'cart', 'voltage': 'u'})
+    assert np.array_equal(a.x, b.x) and len(a.t) == N
+
+
+def test_overruns_are_found_and_only_the_frozen_readings_marked():
+    t = np.arange(20) * 1e-3
+    t[10:] += 2e-3                      # the stamp of row 10 jumps by two periods
+    x = np.arange(20.0)
+    x[11:13] = x[10]                    # rows 11, 12 repeat row 10's reading
+    valid = overruns(t, [x])
+    assert list(np.flatnonzero(~valid)) == [11, 12]
+    jitter = np.arange(20) * 1e-3 + np.random.default_rng(1).uniform(-3e-4, 3e-4, 20)
+    assert overruns(np.sort(jitter), [x]).all()    # jitter of +/-0.3 periods is no overrun
+
+
+def test_wrapped_and_hanging_angles_map_to_upright():
+    th = 0.01 * np.sin(np.linspace(0, 20, 500))
+    hanging = np.angle(np.exp(1j * (th + np.pi)))          # pi at upright, wrapped at +/-pi
+    up, notes = upright_angle(hanging)
+    assert np.allclose(up, th) and any('hanging' in n for n in notes) and any('wrapped' in n for n in notes)
+    same, notes = upright_angle(th)
+    assert np.array_equal(same, th) and notes == []
+
+
+def test_a_record_that_leaves_upright_is_refused(tmp_path):
+    (tmp_path / 'swing.csv').write_text(table(theta=np.linspace(0.0, 2.0, N)))
+    with pytest.raises(ConfigError, match='leaves'):
+        load(tmp_path / 'swing.csv', None)
