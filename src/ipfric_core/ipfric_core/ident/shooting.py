@@ -33,6 +33,7 @@ CART_WINDOW_S = 1.0
 PENDULUM_WINDOW_S = 0.25
 STILL_S = 0.02       # an encoder standing still this long before and after a sample: at rest [s]
 FILTER_HZ = 25.0     # corner of the velocity estimate at window starts [Hz]
+LEAD_S = 0.1         # no window starts earlier: a delayed command there would come from before the record [s]
 
 
 @dataclass(frozen=True)
@@ -87,8 +88,8 @@ def make_windows(rec: Record, length_s: float, forced: bool = False) -> Windows:
     the cart stands still when it can (its state is then known: at rest, held by static
     friction), else from the measured state with velocities from :func:`local_rate`. With
     ``forced``, the angle follows the measurement in them (its rate: :func:`rates`)."""
-    valid = rec.valid_mask
     t, x = rec.t, rec.x
+    valid = rec.valid_mask & (t >= t[0] + LEAD_S)
     th = rec.theta if rec.theta is not None else np.zeros_like(x)
     rest = still(t, x) & valid
     starts, stops = [], []
@@ -111,7 +112,7 @@ def make_windows(rec: Record, length_s: float, forced: bool = False) -> Windows:
     w = (np.array([local_rate(t, th, k) for k in start]) if rec.theta is not None
          else np.zeros(len(start)))
     state = np.column_stack([x[start], th[start], v, w, np.zeros(len(start))])
-    angle = (np.column_stack([rec.theta, rates(t, rec.theta, valid)]) if forced else np.zeros((0, 2)))
+    angle = (np.column_stack([rec.theta, rates(t, rec.theta, rec.valid_mask)]) if forced else np.zeros((0, 2)))
     return Windows(start, stop, state, held, angle)
 
 
