@@ -48,6 +48,8 @@ NODES = {
     'sim_node': ('ipfric_sim', 'sim_node'),
 }
 CONFIG_NAME = 'scenario.yaml'
+#: The ROS_DOMAIN_IDs a run accepts (Fast DDS on Linux: ports 7400 + 250 * domain + ... stay below 65536).
+DOMAINS = (0, 232)
 
 
 # ---------------------------------------------------------------------------- environment
@@ -79,7 +81,7 @@ def domain_in_use(domain: int) -> bool:
 def pick_domain(rng: random.Random | None = None) -> int:
     """A ROS_DOMAIN_ID in 1..232 that no participant on this machine uses."""
     rng = rng or random.Random(os.getpid() ^ time.monotonic_ns())
-    candidates = list(range(1, 233))
+    candidates = list(range(max(1, DOMAINS[0]), DOMAINS[1] + 1))
     rng.shuffle(candidates)
     for d in candidates:
         if not domain_in_use(d):
@@ -198,7 +200,17 @@ class Run:
 
     # -- start -----------------------------------------------------------------------------
     def prepare(self) -> Path:
-        """Validate the scenario and write OUT/scenario.yaml (raises ConfigError)."""
+        """Validate the arguments and the scenario, then write OUT/scenario.yaml (raises ConfigError)."""
+        if self.domain is not None:
+            if not DOMAINS[0] <= self.domain <= DOMAINS[1]:
+                raise ConfigError(f'--domain: {self.domain} is out of range; allowed {DOMAINS[0]}..{DOMAINS[1]}')
+            if domain_in_use(self.domain):
+                raise ConfigError(f'--domain: ROS domain {self.domain} is in use by another process on this '
+                                  f'machine; give another or leave --domain out (a free one is picked)')
+        if self.timeout is not None and not (math.isfinite(self.timeout) and self.timeout > 0):
+            raise ConfigError(f'--timeout: {self.timeout!r} must be > 0 wall seconds')
+        if self.out.exists() and not self.out.is_dir():
+            raise ConfigError(f'--out: {self.out} is a file; give a directory (created if missing)')
         load_scenario(self.config)
         data = load_yaml(self.config)
         if self.duration is not None:
