@@ -106,7 +106,7 @@ TRUTH_FIELDS = ('x', 'theta', 'x_dot', 'theta_dot', 'friction_force', 'z', 'stuc
 ABSURD = {'joint_states': (1e3, 1e4), 'plant_state': (1e3, 1e4, 1e4, 1e6, 1e6, 1e3, 1.0, 1e6)}
 
 MAGIC = b'\x89MCAP0\r\n'
-OP_HEADER, OP_FOOTER, OP_SCHEMA, OP_CHANNEL, OP_MESSAGE, OP_CHUNK = 1, 2, 3, 4, 5, 6
+OP_FOOTER, OP_SCHEMA, OP_CHANNEL, OP_MESSAGE, OP_CHUNK = 2, 3, 4, 5, 6
 OP_METADATA, OP_DATA_END, OP_STATISTICS, OP_MAX = Opcode.METADATA, Opcode.DATA_END, Opcode.STATISTICS, 0x0F
 RECORDS = {OP_SCHEMA: Schema, OP_CHANNEL: Channel, OP_MESSAGE: Message, OP_METADATA: Metadata}
 COMPRESSIONS = ('', 'zstd', 'lz4')
