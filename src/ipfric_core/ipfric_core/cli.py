@@ -31,8 +31,8 @@ def _eig_text(pairs) -> str:
 
 
 def cmd_design(args) -> int:
+    cfg = load_paper_config(args.config)      # bad input refused before the long imports
     from .design.reports import design_report
-    cfg = load_paper_config(args.config)
     rep = design_report(cfg, Path(args.data) / 'paper')
     if args.json:
         _print_json(rep)
@@ -64,8 +64,9 @@ def cmd_design(args) -> int:
 
 
 def cmd_stability(args) -> int:
+    cfg = load_paper_config(args.config)
     from .design.reports import stability_report
-    rep = stability_report(load_paper_config(args.config))
+    rep = stability_report(cfg)
     if args.json:
         _print_json(rep)
         return 0
