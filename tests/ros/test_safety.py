@@ -5,6 +5,7 @@ Live: each node against a peer in the test process (its own ROS domain on loopba
 the simulator receiving NaN, infinite and out-of-range commands; the controller
 receiving a NaN measurement and refusing bad parameter values at run time.
 """
+import json
 import math
 
 import pytest
@@ -32,13 +33,25 @@ def test_guard_zero_order_hold_bad_command_and_watchdog():
     g = CommandGuard(voltage_max=10.0, watchdog_samples=3)
     assert g.apply(2.0) == (2.0, [])
     assert g.apply(None) == (2.0, [])                       # held
-    v, ev = g.apply(math.nan)
-    assert v == 0.0 and ev == [(BAD_COMMAND, 'voltage is NaN; 0 V applied')]
+    v, ev = g.apply(math.nan, k=2, now=0.0)
+    assert v == 0.0 and ev == [(BAD_COMMAND, 'command refused at sample 2: voltage is NaN; 0 V applied')]
     v, ev = g.apply(None)                                    # third sample without a valid command
     assert v == 0.0 and [c for c, _ in ev] == [WATCHDOG] and g.tripped
-    assert g.apply(50.0) == (0.0, [])                        # refused silently while tripped
+    assert g.apply(50.0, k=4, now=0.1) == (0.0, [])         # counted, reported with its burst
+    assert g.apply(math.inf, k=5, now=0.2) == (0.0, [])
+    assert g.refusals.report(0.5) is None                    # one report per second at most
+    assert g.refusals.report(1.0) == '2 more command(s) refused since sample 4: 1 inf, 1 out of range'
     assert g.apply(1.5) == (1.5, []) and not g.tripped       # valid commands resume
-    assert g.refused == 2 and g.missing == 2
+    assert g.refused == 3 and g.missing == 2 and g.trips == 1
+
+
+def test_a_burst_of_refusals_gives_two_events_with_counts():
+    g = CommandGuard(voltage_max=10.0, watchdog_samples=10 ** 6)
+    events = [ev for k in range(5000) for ev in g.apply(math.nan, k=k, now=k * 2e-4)[1]]
+    events += [(BAD_COMMAND, g.refusals.report(1.0, force=True))]
+    assert [c for c, _ in events] == [BAD_COMMAND, BAD_COMMAND]
+    assert events[1][1] == '4999 more command(s) refused since sample 1: 4999 NaN'
+    assert g.refused == 5000
 
 
 def test_sim_refuses_nan_inf_and_out_of_range_commands(tmp_path):
@@ -77,9 +90,12 @@ def test_sim_refuses_nan_inf_and_out_of_range_commands(tmp_path):
             sim.kill()
             sim.wait()
     codes = [(e.sample_index, e.code) for e in events]
-    assert codes == [(0, 'START'), (10, BAD_COMMAND), (20, BAD_COMMAND), (30, BAD_COMMAND), (50, 'END')]
+    assert codes == [(0, 'START'), (10, BAD_COMMAND), (50, BAD_COMMAND), (50, 'END')]   # one burst
     details = [e.detail for e in events if e.code == BAD_COMMAND]
-    assert 'NaN' in details[0] and 'inf' in details[1] and 'exceeds voltage_max' in details[2]
+    assert 'sample 10: voltage is NaN' in details[0]
+    assert details[1] == '2 more command(s) refused since sample 20: 1 inf, 1 out of range'
+    result = json.loads((tmp_path / 'result.json').read_text())
+    assert result['commands_refused'] == 3 and result['refused_by_kind'] == {'NaN': 1, 'inf': 1, 'out of range': 1}
     # V_k acts over [t_k, t_k+1): plant_state k+1 shows it
     for k in range(1, 51):
         assert applied[k] == (0.0 if k - 1 in bad else 1.0), k

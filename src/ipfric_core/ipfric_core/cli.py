@@ -31,8 +31,8 @@ def _eig_text(pairs) -> str:
 
 
 def cmd_design(args) -> int:
+    cfg = load_paper_config(args.config)      # bad input refused before the long imports
     from .design.reports import design_report
-    cfg = load_paper_config(args.config)
     rep = design_report(cfg, Path(args.data) / 'paper')
     if args.json:
         _print_json(rep)
@@ -64,8 +64,9 @@ def cmd_design(args) -> int:
 
 
 def cmd_stability(args) -> int:
+    cfg = load_paper_config(args.config)
     from .design.reports import stability_report
-    rep = stability_report(load_paper_config(args.config))
+    rep = stability_report(cfg)
     if args.json:
         _print_json(rep)
         return 0
@@ -121,6 +122,8 @@ def cmd_run(args) -> int:
 def _print_analysis(r: dict) -> None:
     """Readable summary of one :func:`analysis.analyze_run` result."""
     print(f'{r["path"]}: {r["class"]}' + (' (TRUNCATED: ' + r['truncation_detail'] + ')' if r['truncated'] else ''))
+    for d in r.get('damage', ()):
+        print(f'  DAMAGED: {d}')
     if r.get('class') is None:
         return
     tt = r['transition_time']
@@ -138,19 +141,22 @@ def _print_analysis(r: dict) -> None:
 
 
 def cmd_analyze(args) -> int:
+    """Exit code 0: every bag intact; 1: a bag truncated or damaged (what was read is analysed,
+    the loss stated); 2: an input refused (not an MCAP file, no bag)."""
     from .analysis.recorded_run import analyze_run, overlay_runs
     results = [analyze_run(p, None if args.no_plots else args.plots) for p in args.runs]
     out = {'runs': results}
     if len(args.runs) > 1 and not args.no_plots:
         out['overlay'] = overlay_runs(args.runs, Path(args.plots) / 'overlay.png')
+    code = 1 if any(r['truncated'] or r['damage'] for r in results) else 0
     if args.json:
         _print_json(out)
-        return 0
+        return code
     for r in results:
         _print_analysis(r)
     if 'overlay' in out:
         print(f'overlay: {out["overlay"]["figure"]}')
-    return 0
+    return code
 
 
 def _sweep_base(config, sensors, smoothing, cutoff_hz=None):

@@ -19,6 +19,8 @@ from rclpy.exceptions import (InvalidParameterTypeException, InvalidParameterVal
                               ParameterException)
 from rclpy.parameter import Parameter
 
+from .rclpy_internals import parameter_overrides
+
 _TYPES = {bool: ParameterType.PARAMETER_BOOL, int: ParameterType.PARAMETER_INTEGER,
           float: ParameterType.PARAMETER_DOUBLE, str: ParameterType.PARAMETER_STRING}
 
@@ -55,7 +57,7 @@ def descriptor(name: str, default, description: str, rng=None, read_only: bool =
 
 def _coerce_override(node, name: str, ptype: int) -> None:
     """Accept an integer in the parameter file where a double is declared (``duration: 5``)."""
-    overrides = getattr(node, '_parameter_overrides', None)
+    overrides = parameter_overrides(node)
     if not overrides or name not in overrides:
         return
     value = overrides[name].value
@@ -74,7 +76,7 @@ def declare(node, section: str, name: str, default, description: str, rng=None,
     try:
         return node.declare_parameter(name, default, desc).value
     except (InvalidParameterTypeException, InvalidParameterValueException, ParameterException) as exc:
-        given = getattr(node, '_parameter_overrides', {}).get(name)
+        given = parameter_overrides(node).get(name)
         shown = repr(plain(given.value)) if given is not None else '?'
         allowed = f'; allowed {desc.additional_constraints}' if desc.additional_constraints else ''
         raise ConfigError(f'{section}.ros__parameters.{name}: {shown} refused ({_reason(exc)}){allowed}') from exc
@@ -87,8 +89,7 @@ def _reason(exc: Exception) -> str:
 
 def check_unknown(node, section: str) -> None:
     """Refuse names in the parameter file that the node does not declare (typos)."""
-    # rclpy keeps the parameter-file entries only in this attribute (no public accessor)
-    overrides = getattr(node, '_parameter_overrides', {}) or {}
+    overrides = parameter_overrides(node) or {}
     unknown = sorted(n for n in overrides if not node.has_parameter(n) and not n.startswith('qos_overrides.'))
     if not unknown:
         return

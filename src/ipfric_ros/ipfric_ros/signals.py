@@ -1,15 +1,29 @@
-"""Clean stop on SIGINT / SIGTERM for the ipfric nodes.
+"""Clean stop on SIGINT / SIGTERM / SIGHUP, and on the death of the supervisor, for the nodes.
 
 rclpy's own handlers shut the context down at once, after which a node can publish
 nothing: the simulator could not announce why the run ended and the recorder could not
 take the messages still queued. The nodes therefore initialise rclpy without signal
 handlers and install these, which only record the request; every node loop waits with a
 short timeout and checks it.
+
+A node started by ``./ipfric run`` (environment ``IPFRIC_SUPERVISED=1``) also stops when
+its supervisor dies, however it dies (``kill -9`` included): the kernel sends it SIGTERM
+when its parent exits (``PR_SET_PDEATHSIG``, set here and by the runner before exec), and
+a thread watching its stdin (a pipe whose other end only the supervisor holds) sees the
+end of file. Either way the node stops as on SIGTERM. The recorder watches its pipe only
+and stops ``LINGER_S`` later, so that the simulator's last event is in the bag it closes.
 """
 from __future__ import annotations
 
+import os
 import signal
+import threading
+import time
 from contextlib import contextmanager
+
+from ipfric_core.run.runner import SUPERVISED, die_with_parent
+
+LINGER_S = 1.0    # [s] the recorder's wait after the supervisor died, for the others' last messages
 
 
 class StopRequest:
@@ -28,9 +42,24 @@ class StopRequest:
     def install(self) -> 'StopRequest':
         def handler(signum, _frame):
             self.request(signal.Signals(signum).name)
-        signal.signal(signal.SIGINT, handler)
-        signal.signal(signal.SIGTERM, handler)
+        for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+            signal.signal(sig, handler)
         return self
+
+    def watch_supervisor(self, fd: int = 0, linger: float = 0.0) -> threading.Thread:
+        """Request a stop ``linger`` s after file descriptor ``fd`` (stdin) reached its end: the
+        supervisor is gone.
+
+        (Unbuffered reads: a thread blocked in ``sys.stdin`` would abort the interpreter's exit.)
+        """
+        def watch():
+            while os.read(fd, 4096):
+                pass
+            time.sleep(linger)
+            self.request('the end of the supervisor (its pipe closed)')
+        t = threading.Thread(target=watch, name='supervisor-watch', daemon=True)
+        t.start()
+        return t
 
 
 class NodeProcess:
@@ -39,6 +68,14 @@ class NodeProcess:
     def __init__(self, name: str):
         import rclpy
         self.stop = StopRequest().install()
+        if os.environ.get(SUPERVISED) == '1':
+            # the recorder outlives the others by LINGER_S to take their last messages
+            linger = LINGER_S if name == 'recorder' else 0.0
+            if not linger:
+                die_with_parent()
+            if os.getppid() == 1:               # the parent died before prctl
+                self.stop.request('the end of the supervisor (before start-up)')
+            self.stop.watch_supervisor(linger=linger)
         self.logger = rclpy.logging.get_logger(name)
         self.nodes: list = []
 
@@ -53,6 +90,9 @@ def node_process(name: str, args=None):
     is destroyed and rclpy shut down, whatever happened."""
     import rclpy
     from rclpy.signals import SignalHandlerOptions
+
+    from .rclpy_internals import check_version
+    check_version()
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     proc = NodeProcess(name)
     try:

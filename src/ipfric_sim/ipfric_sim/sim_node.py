@@ -16,16 +16,20 @@ over [t_k, t_k+1) (zero-order hold). ``time_mode``:
 - ``realtime``: sample k at wall time t0 + k dt; the latest command is held.
 
 Safety (``safety_event``, ipfric_msgs/SafetyEvent): a NaN, infinite or out-of-range
-command gives 0 V (BAD_COMMAND); no valid command for ``watchdog_samples`` samples gives
-0 V (WATCHDOG); the run ends on TRACK_LIMIT, FALLEN, END (duration reached) or ABORT
-(SIGINT/SIGTERM), announced as an event whose detail lists the messages published.
+command, a command for another sample (lockstep) or from another publisher than the
+controller gives 0 V and is counted (BAD_COMMAND: the first of a burst at once, then one
+summary per second with counts); no valid command for ``watchdog_samples`` samples, or for
+a second of wall time in lockstep, gives 0 V (WATCHDOG, with STALL when the controller
+stopped answering); a second publisher on a topic of the run is named (INTRUDER). Commands
+are taken with a deadline: a flood cannot hold a sample. The run ends on TRACK_LIMIT,
+FALLEN, END (duration reached) or ABORT (SIGINT/SIGTERM/SIGHUP, or the supervisor gone),
+announced as an event whose detail lists the messages published.
 All numerics live in ipfric_core (Scenario, Rig); this node adds topics and timing.
 """
 from __future__ import annotations
 
 import json
 import sys
-import threading
 import time
 from array import array
 from collections import Counter
@@ -38,7 +42,6 @@ from ipfric_core.physics.params import ConfigError
 from ipfric_msgs.msg import PlantState, SafetyEvent, VoltageCommand
 from rclpy.duration import Duration
 from rclpy.executors import SingleThreadedExecutor
-from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
@@ -46,9 +49,13 @@ from std_msgs.msg import Float64MultiArray
 
 from ipfric_ros import topics
 from ipfric_ros.parameters import check_unknown, declare, declare_scenario
+from ipfric_ros.rclpy_internals import SubscriptionWaiter, publisher_gid
 from ipfric_ros.signals import StopRequest, node_process
 
-from .safety import CommandGuard
+from .safety import BAD_COMMAND, WATCHDOG_WALL_S, CommandGuard
+
+#: Most commands taken in one drain (a flood is cut into slices between samples).
+DRAIN_MAX = 1000
 
 
 class StartError(RuntimeError):
@@ -93,37 +100,46 @@ class SimNode(Node):
         self.pub_joints = self.create_publisher(JointState, topics.JOINT_STATES, qos)
         self.pub_state = self.create_publisher(PlantState, topics.PLANT_STATE, qos)
         self.pub_event = self.create_publisher(SafetyEvent, topics.SAFETY_EVENT, topics.data_qos(100))
-        self.sub_command = self.create_subscription(VoltageCommand, topics.VOLTAGE_COMMAND,
-                                                    self._on_command, qos)
+        self.sub_command = self.create_subscription(
+            VoltageCommand, topics.VOLTAGE_COMMAND, lambda msg, info: self._on_command(msg, publisher_gid(info)), qos)
         self.sub_gain = self.create_subscription(Float64MultiArray, topics.CONTROLLER_GAIN,
                                                  self._on_gain, topics.latched_qos())
         self.published = Counter()
         self.gain = None
-        self.stale = 0
+        self.controller_gid = None  # the publisher GID commands are accepted from
+        self.intruders = {}         # topic -> publishers seen beyond the expected one
+        self.stalls = 0
+        self._stalled = False
+        self._last_valid = time.monotonic()
         self._sent_at = array('d')  # [s] monotonic time measurement k was published, at index k
         self.latency = array('d')   # [s] from publishing a measurement to taking its command
         self._waiting_for = -1      # lockstep: sample whose command is awaited
         self._command = None        # lockstep: its voltage; realtime: latest unused voltage
         self._executor = SingleThreadedExecutor()
         self._executor.add_node(self)
-        # rclpy's own wait set type, as used by rclpy.wait_for_message
-        self._wait_set = _rclpy.WaitSet(1, 0, 0, 0, 0, 0, self.context.handle)
+        self._commands = SubscriptionWaiter(self, self.sub_command)
         self.get_logger().info(
             f'{s.time_mode} at {s.sample_rate_hz:g} Hz, duration {s.duration:g} s, theta0 {s.theta0:g} rad, '
             f'friction {self.scenario.friction.model}; encoder {s.cart_resolution:g} m, '
             f'{s.angle_resolution:g} rad')
 
     # -- subscriptions ---------------------------------------------------------------------
-    def _on_command(self, msg: VoltageCommand) -> None:
-        if not self.lockstep or msg.sample_index == self._waiting_for:
-            self._command = msg.voltage
-        else:
-            self.stale += 1
-            self.get_logger().warning(f'command for sample {msg.sample_index} ignored while waiting for '
-                                      f'sample {self._waiting_for}', throttle_duration_sec=1.0)
+    def _on_command(self, msg: VoltageCommand, gid: bytes) -> None:
+        if self.controller_gid is not None and gid != self.controller_gid:
+            self._refuse('unexpected publisher', f'a command from publisher {gid.hex()}, not the controller')
             return
-        if msg.sample_index < len(self._sent_at):
+        if self.lockstep and msg.sample_index != self._waiting_for:
+            self._refuse('wrong sample index', f'a command for sample {msg.sample_index} while waiting for '
+                                               f'sample {self._waiting_for}')
+            return
+        self._command = msg.voltage
+        if 0 <= msg.sample_index < len(self._sent_at):
             self.latency.append(time.monotonic() - self._sent_at[msg.sample_index])
+
+    def _refuse(self, kind: str, detail: str) -> None:
+        first = self.guard.refusals.note(kind, detail, self.rig.k, time.monotonic())
+        if first:
+            self.event(BAD_COMMAND, first)
 
     def _on_gain(self, msg: Float64MultiArray) -> None:
         self.gain = list(msg.data)
@@ -166,10 +182,25 @@ class SimNode(Node):
             self.get_logger().warning(text)
 
     def _apply(self, command) -> float:
-        v, events = self.guard.apply(command)
+        now = time.monotonic()
+        v, events = self.guard.apply(command, self.rig.k, now)
+        if self.guard.missed == 0:          # a valid command
+            self._last_valid, self._stalled = now, False
         for code, detail in events:
             self.event(code, detail)
+        summary = self.guard.refusals.report(now)
+        if summary:
+            self.event(BAD_COMMAND, summary)
         return v
+
+    def _check_intruders(self) -> None:
+        """Name a publisher on a topic of the run beyond the expected one (once per count)."""
+        for topic in (topics.VOLTAGE_COMMAND, topics.JOINT_STATES, topics.PLANT_STATE, topics.CLOCK):
+            n = self.count_publishers(topic) - 1
+            if n > self.intruders.get(topic, 0):
+                self.intruders[topic] = n
+                self.event('INTRUDER', f'{n + 1} publishers on {topic}, expected 1: messages from the '
+                                       f'others are refused (commands) or reported (measurements)')
 
     # -- start -----------------------------------------------------------------------------
     def _missing_peers(self) -> list[str]:
@@ -180,6 +211,9 @@ class SimNode(Node):
                    for pub, name, n in need if pub.get_subscription_count() < n]
         if self.sub_command.get_publisher_count() < 1:
             missing.append(f'{topics.VOLTAGE_COMMAND}: no publisher')
+        elif self.sub_command.get_publisher_count() > 1:
+            raise StartError(f'{topics.VOLTAGE_COMMAND} has {self.sub_command.get_publisher_count()} publishers; '
+                             f'expected the controller alone (another run in this ROS domain?)')
         if self.wait_for_gain and self.gain is None:
             missing.append(f'{topics.CONTROLLER_GAIN}: not received')
         return missing
@@ -191,6 +225,8 @@ class SimNode(Node):
             missing = self._missing_peers()
             if not missing:
                 self.get_logger().info(f'peers matched after {time.monotonic() - t0:.2f} s')
+                info = self.get_publishers_info_by_topic(self.sub_command.topic_name)
+                self.controller_gid = bytes(info[0].endpoint_gid) if len(info) == 1 else None
                 return True
             if self.stop:
                 return False
@@ -212,22 +248,25 @@ class SimNode(Node):
         """Lockstep hot path: wait up to ``timeout`` s on the command subscription alone, take
         what arrived. Cheaper than an executor turn, which waits on every entity of the node
         (parameter services included); those are served by an executor turn every 100 samples.
+        The drain stops after ``DRAIN_MAX`` messages or ``timeout`` + 2 ms, whichever first, so
+        that a flood cannot hold the sample.
         """
-        ws, handle = self._wait_set, self.sub_command.handle
-        ws.clear_entities()
-        ws.add_subscription(handle)
-        ws.wait(int(timeout * 1e9))
-        while True:
-            got = handle.take_message(VoltageCommand, False)
+        self._commands.wait(timeout)
+        end = time.monotonic() + timeout + 0.002
+        for _ in range(DRAIN_MAX):
+            got = self._commands.take()
             if got is None:
                 return
-            self._on_command(got[0])
+            self._on_command(*got)
+            if self._command is not None or time.monotonic() > end:
+                return
 
     def _await_command(self, k: int):
         """Lockstep: wait until the command for sample k arrives; None on timeout."""
         self._waiting_for, self._command = k, None
         if k % 100 == 0:
             self._executor.spin_once(timeout_sec=0.0)
+            self._check_intruders()
         self._take_commands(0.0)
         if self._command is not None or self.guard.tripped:
             # with the watchdog tripped (0 V held) the rig runs on, taking a command if one is there
@@ -236,6 +275,9 @@ class SimNode(Node):
         deadline = t0 + self.settings.lockstep_timeout_s
         while self._command is None and not self.stop:
             now = time.monotonic()
+            if now - self._last_valid >= WATCHDOG_WALL_S:
+                self._stall(k, now)
+                break
             if now >= deadline:
                 self.get_logger().warning(f'no command for sample {k} within '
                                           f'{self.settings.lockstep_timeout_s:g} s',
@@ -246,6 +288,17 @@ class SimNode(Node):
                 break
             self._take_commands(min(0.02, deadline - now))
         return self._command
+
+    def _stall(self, k: int, now: float) -> None:
+        """No valid command for WATCHDOG_WALL_S of wall time: STALL once per episode, watchdog."""
+        if not self._stalled:
+            self._stalled = True
+            self.stalls += 1
+            self.event('STALL', f'no valid command for {now - self._last_valid:.2f} s of wall time (sample {k}): '
+                                f'the controller is paused, too slow or gone')
+        ev = self.guard.trip(f'no valid command for {WATCHDOG_WALL_S:g} s of wall time')
+        if ev:
+            self.event(*ev)
 
     def run_lockstep(self):
         while True:
@@ -279,6 +332,7 @@ class SimNode(Node):
             self.rig.step(v)
             if self.rig.k % 100 == 0:
                 self._executor.spin_once(timeout_sec=0.0)
+                self._check_intruders()
             deadline = t0 + self.rig.k * period
             now = time.monotonic()
             if now > deadline + period:
@@ -296,9 +350,12 @@ class SimNode(Node):
         self.event('START', f'{self.settings.time_mode} run of {self.settings.duration:g} s, '
                             f'friction {self.scenario.friction.model}, theta0 {self.settings.theta0:g} rad'
                             + (f', gain {self.gain}' if self.gain else ''))
-        t0 = time.monotonic()
+        t0 = self._last_valid = time.monotonic()
         code, detail = self.run_lockstep() if self.lockstep else self.run_realtime()
         wall = time.monotonic() - t0
+        summary = self.guard.refusals.report(time.monotonic(), force=True)
+        if summary:
+            self.event(BAD_COMMAND, summary)
         samples = self.rig.k + 1
         self.published[topics.SAFETY_EVENT] += 1  # the event below
         counts = dict(sorted(self.published.items()))
@@ -309,8 +366,9 @@ class SimNode(Node):
             'end_reason': code, 'detail': detail, 'samples': samples, 'last_sample': self.rig.k,
             'sim_time_s': self.rig.k * self.period_ns * 1e-9, 'wall_time_s': wall,
             'steps_per_s': samples / wall if wall > 0 else None, 'published': dict(self.published),
-            'commands_refused': self.guard.refused, 'samples_without_command': self.guard.missing,
-            'stale_commands': self.stale, 'watchdog_tripped': self.guard.tripped,
+            'commands_refused': self.guard.refused, 'refused_by_kind': dict(self.guard.refusals.total),
+            'samples_without_command': self.guard.missing, 'watchdog_trips': self.guard.trips,
+            'stalls': self.stalls, 'intruders': self.intruders,
             'command_latency_s': self._latency_summary(),
             'time_mode': self.settings.time_mode, 'gain': self.gain,
         }
@@ -330,23 +388,18 @@ class SimNode(Node):
                 'p99': float(np.percentile(lat, 99)), 'max': float(lat.max())}
 
     def _flush(self, timeout: float = 5.0) -> None:
-        """Wait until every subscriber acknowledged what was published (reliable QoS).
-
-        The publishers are waited for in parallel: each wait lasts up to a heartbeat period.
+        """Wait until every subscriber acknowledged what was published (reliable QoS), ``timeout``
+        [s] in all: rclpy holds the interpreter while it waits, so the publishers are waited for
+        one after the other within one deadline; once one times out (a subscriber gone without a
+        goodbye, e.g. a killed recorder) the others are not waited for.
         """
-        pubs = (self.pub_clock, self.pub_joints, self.pub_state, self.pub_event)
-        acked = {}
-
-        def wait(pub):
-            acked[pub.topic_name] = pub.wait_for_all_acked(Duration(seconds=timeout))
-        threads = [threading.Thread(target=wait, args=(p,)) for p in pubs]
-        for t in threads:
-            t.start()
-        for t in threads:
-            t.join()
-        for name, ok in acked.items():
-            if not ok:
-                self.get_logger().warning(f'{name}: not all messages acknowledged in {timeout:g} s')
+        deadline = time.monotonic() + timeout
+        for pub in (self.pub_event, self.pub_joints, self.pub_state, self.pub_clock):
+            left = deadline - time.monotonic()
+            if left <= 0 or not pub.wait_for_all_acked(Duration(nanoseconds=int(left * 1e9))):
+                self.get_logger().warning(f'{pub.topic_name}: not all messages acknowledged within '
+                                          f'{timeout:g} s; not waiting further')
+                return
 
 
 def main(args=None) -> int:

@@ -35,12 +35,13 @@ def analyze_run(path: str | Path, plot_dir: str | Path | None = None, window: fl
     ended = run.end_reason in ('FALLEN', 'TRACK_LIMIT')
     if len(run.t) < 2:
         return {'path': str(path), 'class': None, 'samples': int(len(run.t)), 'truncated': run.truncated,
-                'truncation_detail': run.truncation_detail, 'error': 'fewer than 2 samples'}
+                'truncation_detail': run.truncation_detail, 'damage': run.damage, 'error': 'fewer than 2 samples'}
     o = classify(run.t, run.x, run.theta, _resolution(run), fallen, ended_fallen=ended,
                  window=min(window, 0.5 * float(run.t[-1] - run.t[0]) or window))
     out = {'path': str(path), 'samples': int(len(run.t)), 'duration_s': float(run.t[-1] - run.t[0]),
            'end_reason': run.end_reason, 'truncated': run.truncated,
-           'truncation_detail': run.truncation_detail, 'counts': run.counts, 'gain': run.gain,
+           'truncation_detail': run.truncation_detail, 'damage': run.damage, 'counts': run.counts,
+           'gain': run.gain,
            **{('class' if k == 'cls' else k): v for k, v in o.to_dict().items()}}
     if plot_dir is not None:
         d = Path(plot_dir)

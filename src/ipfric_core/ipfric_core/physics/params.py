@@ -7,6 +7,7 @@ the value and what is allowed.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Mapping
@@ -180,19 +181,51 @@ class FrictionParams:
         return FrictionParams(**data)
 
 
+class _Loader(yaml.SafeLoader):
+    """YAML as the ROS 2 parameter parser reads it: ``2e-2`` is a float (YAML 1.2), and a
+    key given twice in one mapping is refused (PyYAML would keep the last one silently)."""
+
+    def construct_mapping(self, node, deep=False):
+        seen = {}
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=True)
+            line = key_node.start_mark.line + 1
+            if key in seen:
+                raise ConfigError(f'{self.name}: key {key!r} given twice, on lines {seen[key]} and {line} '
+                                  f'(keep one)')
+            seen[key] = line
+        return super().construct_mapping(node, deep)
+
+
+_Loader.yaml_implicit_resolvers = {k: list(v) for k, v in yaml.SafeLoader.yaml_implicit_resolvers.items()}
+_Loader.add_implicit_resolver('tag:yaml.org,2002:float',
+                              re.compile(r'^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$'),
+                              list('-+0123456789'))
+
+
 def load_yaml(path: str | Path) -> Any:
-    """Parse a YAML file, turning syntax errors into ConfigError with the location."""
+    """Parse a YAML file (UTF-8), turning every problem into ConfigError with the location."""
     path = Path(path)
     try:
-        text = path.read_text()
+        raw = path.read_bytes()
     except OSError as exc:
         raise ConfigError(f'{path}: cannot read ({exc.strerror})') from exc
     try:
-        data = yaml.safe_load(text)
+        text = raw.decode('utf-8')
+    except UnicodeDecodeError as exc:
+        line = raw[:exc.start].count(b'\n') + 1
+        raise ConfigError(f'{path}: line {line}: byte {raw[exc.start]:#04x} is not UTF-8 text; save the file '
+                          f'as UTF-8') from exc
+    loader = _Loader(text)
+    loader.name = str(path)
+    try:
+        data = loader.get_single_data()
     except yaml.YAMLError as exc:
         mark = getattr(exc, 'problem_mark', None)
         where = f' line {mark.line + 1} column {mark.column + 1}' if mark else ''
         raise ConfigError(f'{path}:{where} malformed YAML: {getattr(exc, "problem", exc)}') from exc
+    finally:
+        loader.dispose()
     if not isinstance(data, Mapping):
         raise ConfigError(f'{path}: expected a mapping at top level, got {type(data).__name__}')
     return data

@@ -10,9 +10,16 @@ that message arrived and the recorder subscribes to each of its topics.
 
 The run ends when the simulator exits (duration reached, a limit crossed, or stopped);
 then the controller and the recorder are stopped with SIGINT, in that order, so that the
-recorder takes every queued message and closes the bag. Ctrl-C does the same. A node
-that dies ends the run with a non-zero exit and a message naming it; the bag recorded up
-to that moment stays readable (as long as the recorder itself is alive).
+recorder takes every queued message and closes the bag. Ctrl-C, SIGTERM and SIGHUP do the
+same. The nodes die with the runner however it dies (``kill -9`` included): the kernel
+sends them SIGTERM (``PR_SET_PDEATHSIG``) and their stdin pipe closes; the recorder then
+closes the bag. A node that dies ends the run with exit code 1 and a message naming it
+once; the bag recorded up to that moment stays readable, and a bag the recorder could not
+close is read back as ``analyze`` reads it, its loss stated.
+
+Exit codes: 0 clean; 1 a node failed; 2 bad input (nothing started); 3 a safety fault
+(watchdog, stalled controller, refused commands, unexpected publisher); 4 the pendulum
+fell or the cart reached the track limit; 130 stopped by Ctrl-C/SIGTERM/SIGHUP.
 
 Output directory ``OUT``: ``bag/`` (metadata.yaml + bag.mcap), ``scenario.yaml`` (the
 parameter file the nodes got, duration applied), ``sim_result.json`` (end reason, samples,
@@ -22,6 +29,7 @@ This module starts processes only; it imports no ROS package.
 """
 from __future__ import annotations
 
+import ctypes
 import json
 import math
 import os
@@ -48,9 +56,26 @@ NODES = {
     'sim_node': ('ipfric_sim', 'sim_node'),
 }
 CONFIG_NAME = 'scenario.yaml'
+#: Exit codes of a run besides 0, 1 (a node failed), 2 (bad input) and 130 (Ctrl-C).
+EXIT_FAULT = 3    # a safety fault: watchdog, stall, refused commands, unexpected publisher
+EXIT_FELL = 4     # the pendulum fell or the cart reached the track limit (otherwise clean)
+#: The ROS_DOMAIN_IDs a run accepts (Fast DDS on Linux: ports 7400 + 250 * domain + ... stay below 65536).
+DOMAINS = (0, 232)
 
 
 # ---------------------------------------------------------------------------- environment
+PR_SET_PDEATHSIG = 1          # linux/prctl.h
+#: Environment variable telling a node that a supervisor watches it (ipfric_ros.signals).
+SUPERVISED = 'IPFRIC_SUPERVISED'
+
+
+def die_with_parent(sig: int = signal.SIGTERM) -> None:
+    """Ask the kernel to send ``sig`` to this process when its parent exits (Linux prctl)."""
+    libc = ctypes.CDLL(None, use_errno=True)
+    if libc.prctl(PR_SET_PDEATHSIG, int(sig), 0, 0, 0) != 0:
+        raise OSError(ctypes.get_errno(), 'prctl(PR_SET_PDEATHSIG) failed')
+
+
 def ros_environment(domain: int) -> dict:
     """The environment of scripts/env.sh plus the run's domain, DDS on loopback only."""
     env_sh = ROOT / 'scripts' / 'env.sh'
@@ -79,7 +104,7 @@ def domain_in_use(domain: int) -> bool:
 def pick_domain(rng: random.Random | None = None) -> int:
     """A ROS_DOMAIN_ID in 1..232 that no participant on this machine uses."""
     rng = rng or random.Random(os.getpid() ^ time.monotonic_ns())
-    candidates = list(range(1, 233))
+    candidates = list(range(max(1, DOMAINS[0]), DOMAINS[1] + 1))
     rng.shuffle(candidates)
     for d in candidates:
         if not domain_in_use(d):
@@ -135,8 +160,10 @@ class RunResult:
     recorded: dict = field(default_factory=dict)
     counts_match: bool | None = None
     failures: list = field(default_factory=list)
+    faults: list = field(default_factory=list)
     interrupted: bool = False
     exit_codes: dict = field(default_factory=dict)
+    bag_loss: list = field(default_factory=list)
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -150,14 +177,18 @@ class RunResult:
         else:
             lines.append(f'run: no end reason (the simulator did not finish), ROS domain {self.domain}')
         if self.recorded:
-            lines.append(f'bag: {self.bag} (rosbag2, MCAP), '
+            lines.append(f'bag: {self.bag} (rosbag2, MCAP{", NOT CLOSED" if self.bag_loss else ""}), '
                          + ', '.join(f'{t} {n}' for t, n in self.recorded.items()))
         else:
-            lines.append(f'bag: {self.bag}: not readable (no metadata.yaml)')
+            lines.append(f'bag: {self.bag}: not readable')
+        for loss in self.bag_loss:
+            lines.append(f'bag loss: {loss}')
         if self.counts_match is not None:
             lines.append('recorded == published by sim_node: ' + ('yes' if self.counts_match else 'NO'))
         for f in self.failures:
             lines.append(f'FAILED: {f}')
+        for f in self.faults:
+            lines.append(f'FAULT: {f}')
         if self.interrupted:
             lines.append('interrupted (Ctrl-C): all nodes stopped')
         lines.append(f'logs: {Path(self.out) / "logs"}')
@@ -198,7 +229,17 @@ class Run:
 
     # -- start -----------------------------------------------------------------------------
     def prepare(self) -> Path:
-        """Validate the scenario and write OUT/scenario.yaml (raises ConfigError)."""
+        """Validate the arguments and the scenario, then write OUT/scenario.yaml (raises ConfigError)."""
+        if self.domain is not None:
+            if not DOMAINS[0] <= self.domain <= DOMAINS[1]:
+                raise ConfigError(f'--domain: {self.domain} is out of range; allowed {DOMAINS[0]}..{DOMAINS[1]}')
+            if domain_in_use(self.domain):
+                raise ConfigError(f'--domain: ROS domain {self.domain} is in use by another process on this '
+                                  f'machine; give another or leave --domain out (a free one is picked)')
+        if self.timeout is not None and not (math.isfinite(self.timeout) and self.timeout > 0):
+            raise ConfigError(f'--timeout: {self.timeout!r} must be > 0 wall seconds')
+        if self.out.exists() and not self.out.is_dir():
+            raise ConfigError(f'--out: {self.out} is a file; give a directory (created if missing)')
         load_scenario(self.config)
         data = load_yaml(self.config)
         if self.duration is not None:
@@ -223,6 +264,7 @@ class Run:
         logdir = self.out / 'logs'
         logdir.mkdir(exist_ok=True)
         env['ROS_LOG_DIR'] = str(logdir / 'ros')
+        env[SUPERVISED] = '1'
         sim_params = {'wait_for_recorder': 'true', 'result_file': str(self.out / 'sim_result.json')}
         sim_params.update({k: str(v).lower() if isinstance(v, bool) else str(v)
                            for k, v in self.sim_params.items()})
@@ -239,9 +281,12 @@ class Run:
             self.logs[name] = logdir / f'{name}.log'
             f = open(self.logs[name], 'w')
             self._files.append(f)
+            # a node dies with the runner: SIGTERM from the kernel, and the end of its stdin pipe
+            # (the recorder, by the pipe alone, a little later: ipfric_ros.signals)
             self.procs[name] = subprocess.Popen([str(exe), '--ros-args', *args[name]], env=env, cwd=self.out,
-                                                stdout=f, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
-                                                start_new_session=True)
+                                                stdout=f, stderr=subprocess.STDOUT, stdin=subprocess.PIPE,
+                                                start_new_session=True,
+                                                preexec_fn=None if name == 'recorder' else die_with_parent)
 
     def kill(self) -> None:
         """SIGKILL every process still running (last resort, e.g. a failed test)."""
@@ -311,7 +356,8 @@ class Run:
             if stop_at is not None and now >= stop_at:
                 self._signal('sim_node')
                 signalled = now
-        if sim.returncode != 0:
+        if sim.returncode != 0 and not (signalled is not None and self.failures):
+            # (a simulator stopped by the runner after a named failure is not a second failure)
             self.failures.append(self._died('sim_node'))
 
     def wait(self) -> RunResult:
@@ -330,6 +376,9 @@ class Run:
         finally:
             for f in self._files:
                 f.close()
+            for p in self.procs.values():
+                if p.stdin:
+                    p.stdin.close()
         return self.result()
 
     # -- result ----------------------------------------------------------------------------
@@ -339,34 +388,67 @@ class Run:
             sim = json.loads((self.out / 'sim_result.json').read_text())
         except (OSError, ValueError):
             pass
-        recorded = {}
-        try:
-            meta = yaml.safe_load((self.out / 'bag' / 'metadata.yaml').read_text())
-            for t in meta['rosbag2_bagfile_information']['topics_with_message_count']:
-                recorded[t['topic_metadata']['name']] = t['message_count']
-        except (OSError, ValueError, KeyError, TypeError, yaml.YAMLError):
-            pass
+        recorded, loss = self.recorded()
         published = sim.get('published', {})
         match = None
         if published and recorded:
             match = all(recorded.get(t) == n for t, n in published.items())
         if match is False:
-            self.failures.append('recorded counts differ from the published counts: '
-                                 f'published {published}, recorded {recorded}')
+            lost = ', '.join(f'{t} {recorded.get(t, 0)} of {n}' for t, n in published.items()
+                             if recorded.get(t) != n)
+            # a bag the recorder did not close: its loss, already a named failure of the recorder
+            (loss if loss else self.failures).append(f'recorded of the messages published: {lost}')
+        faults = sim_faults(sim)
         code = 0
         if self.failures:
             code = 1
+        elif faults:
+            code = EXIT_FAULT
         elif self.interrupted:
             code = 130
+        elif sim.get('end_reason') in ('FALLEN', 'TRACK_LIMIT'):
+            code = EXIT_FELL
         res = RunResult(exit_code=code, end_reason=sim.get('end_reason'), detail=sim.get('detail'),
                         out=str(self.out), bag=str(self.out / 'bag'), domain=self.domain,
                         samples=sim.get('samples'), sim_time_s=sim.get('sim_time_s'),
                         wall_time_s=sim.get('wall_time_s'), steps_per_s=sim.get('steps_per_s'),
                         published=published, recorded=recorded, counts_match=match,
-                        failures=list(self.failures), interrupted=self.interrupted,
-                        exit_codes={n: p.returncode for n, p in self.procs.items()})
+                        failures=list(self.failures), faults=faults, interrupted=self.interrupted,
+                        exit_codes={n: p.returncode for n, p in self.procs.items()}, bag_loss=loss)
         (self.out / 'summary.json').write_text(json.dumps(res.to_dict(), indent=2))
         return res
+
+
+    def recorded(self) -> tuple[dict, list]:
+        """Messages per topic in the bag, and what was lost: from metadata.yaml (the recorder
+        closed the bag), else read from the .mcap itself as ``analyze`` reads it."""
+        try:
+            meta = yaml.safe_load((self.out / 'bag' / 'metadata.yaml').read_text())
+            return {t['topic_metadata']['name']: t['message_count']
+                    for t in meta['rosbag2_bagfile_information']['topics_with_message_count']}, []
+        except (OSError, ValueError, KeyError, TypeError, yaml.YAMLError):
+            pass
+        from ..analysis.bagread import read_run
+        try:
+            bag = read_run(self.out / 'bag')
+        except ConfigError as exc:
+            return {}, [str(exc)]
+        return bag.counts, [f'not closed by the recorder: {bag.truncation_detail}'] * bag.truncated + bag.damage
+
+
+def sim_faults(sim: dict) -> list[str]:
+    """The safety faults a simulator result reports: watchdog, stalls, refused commands, intruders."""
+    out = []
+    if sim.get('stalls'):
+        out.append(f'the controller stalled {sim["stalls"]} time(s) (no command for a second of wall time)')
+    if sim.get('watchdog_trips'):
+        out.append(f'the watchdog tripped {sim["watchdog_trips"]} time(s) (0 V applied)')
+    if sim.get('commands_refused'):
+        kinds = ', '.join(f'{n} {k}' for k, n in sorted(sim.get('refused_by_kind', {}).items()))
+        out.append(f'{sim["commands_refused"]} command(s) refused ({kinds})')
+    for topic, n in sorted(sim.get('intruders', {}).items()):
+        out.append(f'{n} unexpected publisher(s) on {topic}')
+    return out
 
 
 def run(config, out, duration: float | None = None, **kwargs) -> RunResult:
@@ -381,8 +463,8 @@ def cmd_run(args) -> int:
     def to_interrupt(_signum, _frame):
         raise KeyboardInterrupt
     # explicit: a shell without job control starts background commands with SIGINT ignored
-    signal.signal(signal.SIGINT, to_interrupt)
-    signal.signal(signal.SIGTERM, to_interrupt)
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):   # SIGHUP: the terminal closed
+        signal.signal(sig, to_interrupt)
     r = Run(args.config, args.out, args.duration, domain=args.domain, timeout=args.timeout)
     try:
         r.start()
@@ -401,7 +483,6 @@ def cmd_run(args) -> int:
         sys.stdout.write('\n')
     else:
         print(res.summary())
-    if res.failures:
-        for f in res.failures:
-            print(f'ipfric run: {f}', file=sys.stderr)
+    for f in res.failures + res.faults:
+        print(f'ipfric run: {f}', file=sys.stderr)
     return res.exit_code

@@ -36,6 +36,7 @@ parameters, nested again, to :func:`scenario_from_ros_params`).
 """
 from __future__ import annotations
 
+import difflib
 import math
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
@@ -43,7 +44,6 @@ from typing import Any, Mapping
 
 from ..physics.controller import StateFeedback, delay_samples
 from ..physics.encoder import ANGLE_RESOLUTION_RAD, CART_RESOLUTION_M
-from ..design.lqr import design
 from ..physics.params import (FRICTION_FIELDS, FRICTION_MODELS, PLANT_FIELDS, SMOOTHING, ConfigError, Field,
                      FrictionParams, PlantParams, check_keys, check_number, check_choice, load_yaml)
 from ..physics.plant import CartPendulum
@@ -206,6 +206,7 @@ class Scenario:
         c = self.controller
         if c.gain is not None:
             return list(c.gain)
+        from ..design.lqr import design   # python-control: 2 s of imports only a designed gain needs
         return design(c.plant, c.design_friction, c.Q, c.R).gain[:4].tolist()
 
     def make_rig(self) -> Rig:
@@ -300,6 +301,10 @@ def scenario_from_ros_params(sim_params: Mapping | None, controller_params: Mapp
         sim, plant, friction, truth = SimSettings(), PlantParams(), FrictionParams(), PlantTruth()
     ctrl = parse_controller(controller_params) if controller_params is not None else ControllerSettings(
         gain=(0.0, 0.0, 0.0, 0.0))
+    if sim_params is not None and controller_params is not None and ctrl.sample_rate_hz != sim.sample_rate_hz:
+        raise ConfigError(f'controller_node.ros__parameters.sample_rate_hz: {ctrl.sample_rate_hz:g} Hz differs from '
+                          f'sim_node.ros__parameters.sample_rate_hz: {sim.sample_rate_hz:g} Hz; the controller '
+                          f'answers every sample of the simulator: give both the same rate')
     return Scenario(sim, plant, friction, truth, ctrl)
 
 
@@ -316,6 +321,28 @@ def load_scenario(path: str | Path) -> Scenario:
         sections[node] = sec['ros__parameters']
     unknown = set(data) - {'sim_node', 'controller_node', 'recorder'}
     if unknown:
-        raise ConfigError(f'{path}: unknown section(s) {", ".join(sorted(unknown))}; allowed: '
+        raise ConfigError(f'{path}: unknown section(s) {", ".join(sorted(map(str, unknown)))}; allowed: '
                           f'sim_node, controller_node, recorder')
+    if 'recorder' in data:
+        _check_recorder(path, data['recorder'])
     return scenario_from_ros_params(sections['sim_node'], sections['controller_node'])
+
+
+#: The recorder's parameters (ipfric_record.recorder declares them).
+RECORDER_PARAMS = ('output', 'scenario_file')
+
+
+def _check_recorder(path, section) -> None:
+    """A ``recorder:`` section: ``ros__parameters`` with known names and string values only."""
+    if not isinstance(section, Mapping) or set(section) != {'ros__parameters'} or not isinstance(
+            section['ros__parameters'], Mapping):
+        raise ConfigError(f'{path}: recorder: {section!r} is not a mapping with ros__parameters: '
+                          f'(parameters {", ".join(RECORDER_PARAMS)})')
+    for key, value in section['ros__parameters'].items():
+        if key not in RECORDER_PARAMS:
+            near = difflib.get_close_matches(str(key), RECORDER_PARAMS, 1)
+            raise ConfigError(f'{path}: recorder.ros__parameters.{key}: unknown parameter'
+                              + (f' (did you mean {near[0]!r}?)' if near else '')
+                              + f'; allowed: {", ".join(RECORDER_PARAMS)}')
+        if not isinstance(value, str):
+            raise ConfigError(f'{path}: recorder.ros__parameters.{key}: {value!r} is not a string (a path)')
