@@ -170,12 +170,13 @@ def static_level(p: dict, active) -> float:
 
 
 def position_force(x, p: dict, active):
-    """Forces fixed to the track or constant [N] (offset, cogging): they act at rest too."""
+    """Forces fixed to the track or constant (offset, cogging) as resistance [N]: minus the force
+    on the cart of :func:`ipfric_core.physics.plant.undeclared_force`. They act at rest too."""
     amp, phase, period = 0.0, 0.0, 1.0
     if 'cogging' in active:
         amp, phase, period = np.hypot(p['cog_a'], p['cog_b']), np.arctan2(p['cog_b'], p['cog_a']), p['cog_period']
     ef = (float(amp), float(period), float(phase), float(p['F0']) if 'offset' in active else 0.0)
-    return undeclared_forces(ef, np.ascontiguousarray(x, float))
+    return -undeclared_forces(ef, np.ascontiguousarray(x, float))   # resisting: minus the force on the cart
 
 
 def resisting_force(x, v, p: dict, active, dt: float) -> np.ndarray:

@@ -32,6 +32,7 @@ from scipy.signal import butter, sosfiltfilt
 from . import effects as fx
 from .records import Record
 from ..physics.params import ConfigError
+from ..physics.plant import held_forces, pendulum_residuals, required_forces
 from .residual import signature_scores, whiteness
 
 MIN_GAIN_PERCENT = 1.0
@@ -151,15 +152,11 @@ def balance(pr: Prepared, p: dict, active) -> Balance:
     if 'backlash' in active:
         g = p['gap']
         x, v, a = x + g * pr.Dx, v + g * pr.Dv, a + g * pr.Da
-    model = p['mass'] * a + rec.back_emf * v
-    pend = None
-    if pr.has_theta:
-        m, l, gr = rec.pendulum
-        th = pr.th - p.get('theta_bias', 0.0)
-        c, s = np.cos(th), np.sin(th)
-        model = model + m * (1 - 0.75 * c * c) * a - m * l * s * pr.thd ** 2 + 0.75 * m * gr * c * s
-        pend = m * ((4.0 / 3.0) * l * pr.thdd - gr * s + a * c)
-    model = model + fx.resisting_force(x, v, p, active, pr.dt)
+    pp = plant_vector(rec, p)
+    th = pr.th - p.get('theta_bias', 0.0) if pr.has_theta else np.zeros_like(a)
+    thd = pr.thd if pr.has_theta else np.zeros_like(a)
+    model = required_forces(pp, a, th, thd) + rec.back_emf * v + fx.resisting_force(x, v, p, active, pr.dt)
+    pend = pendulum_residuals(pp, a, th, pr.thdd) if pr.has_theta else None
     used = pr.used
     static = np.zeros(0)
     if len(pr.b_idx):
@@ -168,15 +165,20 @@ def balance(pr: Prepared, p: dict, active) -> Balance:
         # smoothed as the cart's inertia smooths it)
         held = rec.gain * uf_full[pr.b_idx] - fx.position_force(pr.b_x, p, active)
         if pr.has_theta:
-            m, l, gr = rec.pendulum
-            th = pr.b_th - p.get('theta_bias', 0.0)
-            held = held - (0.75 * m * gr * np.cos(th) * np.sin(th) - m * l * np.sin(th) * pr.b_thd ** 2)
+            held = held_forces(pp, pr.b_th - p.get('theta_bias', 0.0), pr.b_thd, held)
         # stuck: static friction held it, |held| <= Fs; breakaway: |held| >= Fs (eq. 5)
         static = np.maximum(0.0, pr.b_kind * (np.abs(held) - fx.static_level(p, active)))
         if 'backlash' in active:  # a cart crossing the play moves while its encoder stands still
             static = np.where(np.abs(v[np.minimum(pr.b_idx // pr.q, len(v) - 1)]) >= rec.stick_velocity,
                               0.0, static)
     return Balance(y, model, np.where(used, y - model, 0.0), used, pend, x, v, uf, static)
+
+
+def plant_vector(rec: Record, p: dict) -> tuple:
+    """The plant vector of :mod:`ipfric_core.physics.plant` with the fitted mass: (M, m, l, g,
+    gain, back-EMF), the pendulum's (m, l, g) when attached, else m = 0."""
+    m, l, g = rec.pendulum if rec.pendulum is not None else (0.0, 1.0, 9.8)
+    return (float(p['mass']), float(m), float(l), float(g), float(rec.gain), float(rec.back_emf))
 
 
 def residual_vector(pr: Prepared, p: dict, active) -> np.ndarray:
@@ -420,7 +422,7 @@ def model_vectors(rec: Record, p: dict, active):
     from .model import ModelVectors
     amp, phase = (math.hypot(p['cog_a'], p['cog_b']), math.atan2(p['cog_b'], p['cog_a'])) if 'cogging' in active \
         else (0.0, 0.0)
-    return ModelVectors((p['mass'], 0.0, 1.0, 9.8, rec.gain, rec.back_emf), fx.friction_vector(p, active),
+    return ModelVectors(plant_vector(rec, p), fx.friction_vector(p, active),
                         (amp, p.get('cog_period', 1.0), phase, p.get('F0', 0.0)), p.get('dz', 0.0) * ('deadzone' in active),
                         p.get('u_max', 0.0) * ('saturation' in active), p.get('gap', 0.0) * ('backlash' in active),
                         p.get('theta_bias', 0.0), p.get('delay', 0.0) * ('delay' in active))

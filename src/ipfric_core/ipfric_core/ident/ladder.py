@@ -225,6 +225,22 @@ def contradictions(pr: Problem, model: Model, name: str) -> list[str]:
     return why
 
 
+#: the parameters that give an effect its size (zero = no effect)
+SIZE = {'deadzone': ('dz',), 'delay': ('delay',), 'cogging': ('cog_a', 'cog_b'), 'asymmetry': ('asym', 'asym_v'),
+        'offset': ('F0',), 'sensor_bias': ('theta_bias',), 'backlash': ('gap',)}
+
+
+def unresolved(model: Model, std: dict, name: str) -> list[str]:
+    """The effect's size is not told from zero: every size parameter within two standard errors."""
+    sizes = [(k, model[k], std.get(k)) for k in SIZE.get(name, ())]
+    if not sizes or any(s is None or not math.isfinite(s) for _, _, s in sizes):
+        return []
+    if all(abs(v) <= 2 * s for _, v, s in sizes):
+        return ['its size is within two standard errors of zero (' +
+                ', '.join(f'{k} = {v:.3g} +/- {s:.2g}' for k, v, s in sizes) + ')']
+    return []
+
+
 def effect_starts(pr: Problem, model: Model, name: str) -> list[dict]:
     """Start values of effect ``name`` (several where the fit has several minima)."""
     rec = pr.rec
@@ -306,7 +322,7 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
             ee0, ee1 = pe.cost(current), pe.cost(m)
             gain = 100 * (1 - math.sqrt(ev1 / ev0)) if ev0 > 0 else 0.0
             p = block_p_value(sse0_v, pv.window_sse(m))
-            why = contradictions(pe, m, name)
+            why = contradictions(pe, m, name) + unresolved(m, s, name)
             if gain <= SIM_GAIN_PERCENT:
                 why.append(f'validation error drops by {gain:.2f} % (needs > {SIM_GAIN_PERCENT:g} %)')
             elif p >= P_VALUE:

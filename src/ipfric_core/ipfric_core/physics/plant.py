@@ -59,6 +59,39 @@ def held_force(pp, theta: float, theta_dot: float, force: float) -> float:
 
 
 @compiled
+def required_forces(pp, x_ddot, theta, theta_dot):
+    """Eq. (16) solved for the force: the horizontal force on the cart [N] (motor, friction and
+    any other) that gives the cart acceleration ``x_ddot`` [m/s^2] with the pendulum at ``theta``,
+    ``theta_dot``, along sampled arrays (the pendulum obeying its own equation)."""
+    m, l, g = pp[MP], pp[L], pp[G]
+    out = np.empty(len(x_ddot))
+    for k in range(len(x_ddot)):
+        s, c = math.sin(theta[k]), math.cos(theta[k])
+        out[k] = x_ddot[k] * (pp[M] + m - 0.75 * m * c * c) - m * l * s * theta_dot[k] ** 2 + 0.75 * m * g * c * s
+    return out
+
+
+@compiled
+def held_forces(pp, theta, theta_dot, force):
+    """:func:`held_force` along sampled arrays [N]."""
+    out = np.empty(len(theta))
+    for k in range(len(theta)):
+        out[k] = held_force(pp, theta[k], theta_dot[k], force[k])
+    return out
+
+
+@compiled
+def pendulum_residuals(pp, x_ddot, theta, theta_ddot):
+    """m ((4/3) l theta'' - g sin(theta) + x'' cos(theta)) [N] along sampled arrays: the
+    pendulum's equation (1) (zero for a pendulum that obeys it)."""
+    m, l, g = pp[MP], pp[L], pp[G]
+    out = np.empty(len(theta))
+    for k in range(len(theta)):
+        out[k] = m * ((4.0 / 3.0) * l * theta_ddot[k] - g * math.sin(theta[k]) + x_ddot[k] * math.cos(theta[k]))
+    return out
+
+
+@compiled
 def stuck_theta_acceleration(pp, theta: float) -> float:
     """theta'' [rad/s^2] while the cart is held at rest: 3 g sin(theta) / (4 l)."""
     return 0.75 * pp[G] * math.sin(theta) / pp[L]
