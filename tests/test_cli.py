@@ -4,6 +4,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -39,6 +41,8 @@ def test_bad_config_is_a_clear_error(tmp_path):
     assert "friction.dynamic.model: 'bristle' is not one of viscous, coulomb, exponential, dynamic" in out.stderr
 
 
+@pytest.mark.ros
+@pytest.mark.slow
 def test_demo_runs_the_default_scenario_and_analyses_it(tmp_path):
     """The README's main job: a closed-loop ROS run of config/default.yaml, then its analysis."""
     out = tmp_path / 'demo'

@@ -129,6 +129,7 @@ def test_angle_sensor_bias_found_in_dithered_closed_loop(tmp_path):
 
 # -- measured data --------------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_emps_beats_the_published_reference_models(data_dir, tmp_path):
     d = data_dir / 'emps'
     assert main(['identify', str(d / 'DATA_EMPS.mat'), '--validation', str(d / 'DATA_EMPS_PULSES.mat'),
@@ -156,6 +157,7 @@ def test_paper_tables_through_the_force_balance(data_dir, paper_cfg):
 
 # -- closing the loop ----------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_redesign_on_identified_stick_slip_shrinks_the_limit_cycle(tmp_path):
     out = close_the_loop(ROOT / 'config' / 'fig7_old_gain_exponential.yaml', tmp_path, 20.0, plots=False)
     assert out['before']['class'] == 'limit_cycle'

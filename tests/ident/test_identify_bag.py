@@ -14,6 +14,8 @@ from ipfric_core.run.scenario import load_scenario
 from rosrun import CONFIG
 
 
+@pytest.mark.ros
+@pytest.mark.slow
 def test_identify_on_run_bag_and_redesign(tmp_path, capsys):
     rig = CONFIG / 'fig7_old_gain_exponential.yaml'
     res = run(rig, tmp_path / 'run', duration=15.0, timeout=180)

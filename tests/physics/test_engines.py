@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 
 from ipfric_core.physics.closedloop import run_closed_loop
-from ipfric_core.analysis.oscillation import classify
 from ipfric_core.physics.rig import PlantTruth
 from ipfric_core.run.scenario import load_scenario
 

@@ -9,12 +9,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from rosrun import CONFIG, p2p, scenario_file
 
 from ipfric_core.analysis.bagread import read_run
 from ipfric_core.physics.closedloop import run_closed_loop
 from ipfric_core.run.runner import run
 from ipfric_core.run.scenario import load_scenario
-from rosrun import CONFIG, p2p, scenario_file
 
 DURATION = {'fig7_old_gain_exponential': 15.0, 'fig9_new_gain_exponential': 12.0,
             'fig10_new_gain_dynamic': 12.0}

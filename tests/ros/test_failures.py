@@ -6,10 +6,10 @@ import sys
 import time
 
 import pytest
+from rosrun import scenario_file, start_node
 
 from ipfric_core.analysis.bagread import read_run
 from ipfric_core.run.runner import ROOT, Run, pick_domain
-from rosrun import scenario_file, start_node
 
 
 def wait_for_start(log, proc, timeout=60.0):

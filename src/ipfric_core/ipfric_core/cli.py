@@ -7,8 +7,8 @@ import math
 import sys
 from pathlib import Path
 
-from .physics.params import ConfigError
 from .design.paperconfig import DEFAULT_CONFIG, DEFAULT_DATA, REPO_ROOT, load_paper_config
+from .physics.params import ConfigError
 
 
 def _print_json(obj) -> None:
@@ -140,7 +140,7 @@ def _print_analysis(r: dict) -> None:
 def cmd_analyze(args) -> int:
     from .analysis.recorded_run import analyze_run, overlay_runs
     results = [analyze_run(p, None if args.no_plots else args.plots) for p in args.runs]
-    out = {'runs': results}
+    out: dict = {'runs': results}
     if len(args.runs) > 1 and not args.no_plots:
         out['overlay'] = overlay_runs(args.runs, Path(args.plots) / 'overlay.png')
     if args.json:
@@ -170,7 +170,7 @@ def _sweep_base(config, sensors, smoothing, cutoff_hz=None):
 
 
 # The paper's Figures 11-12: scenario, variants (label, smoothing, line style), grids (name, theta0 range [deg])
-FIGURES = {
+FIGURES: dict[str, tuple[str, list[tuple[str, str | None, str]]]] = {
     '11': ('fig9_new_gain_exponential.yaml', [('sgn', 'none', '--'), ('tanh(100v)', 'tanh', '-')]),
     '12': ('fig10_new_gain_dynamic.yaml', [('dynamic', None, '-')]),
 }
@@ -187,7 +187,7 @@ def _figure_sweep(args, taus, progress) -> dict:
     panels, result = [], {'figure_of_paper': args.figure, 'config': str(config), 'variants': {}}
     for gname, trange in FIGURE_GRIDS:
         ths = parse_range(trange)
-        panel = {'title': f'θ0 {ths[0]:g}-{ths[-1]:g} deg', 'taus': taus, 'thetas_deg': ths, 'curves': []}
+        panel: dict = {'title': f'θ0 {ths[0]:g}-{ths[-1]:g} deg', 'taus': taus, 'thetas_deg': ths, 'curves': []}
         for label, smoothing, style in variants:
             base = _sweep_base(config, args.sensors, smoothing, args.cutoff_hz)
             d = out / f'{gname}_{smoothing or "model"}'
@@ -298,7 +298,8 @@ def cmd_sweep(args) -> int:
     summary = {'config': args.config, 'sensors': args.sensors, 'duration_s': args.duration,
                'path': 'ros lockstep' if args.ros else 'offline',
                'cells': len(rows), 'figure': str(fig), 'csv': str(out / 'cells.csv'),
-               'counts': {c: sum(r['class'] == c for r in rows) for c in ('settled', 'limit_cycle', 'growing', 'fallen')},
+               'counts': {c: sum(r['class'] == c for r in rows)
+                          for c in ('settled', 'limit_cycle', 'growing', 'fallen')},
                'boundaries': boundaries(rows, taus, ths)}
     (out / 'summary.json').write_text(json.dumps(summary, indent=2, default=float))
     if args.json:
@@ -356,8 +357,8 @@ def cmd_identify(args) -> int:
               f'{rep["breakaway_rms_N"]:.4f} N, curvature of the residual over the velocity range '
               f'{rep["residual_curvature_N"]:+.4f} N')
         return 0
-    from .ident.records import load
     from .ident.identify import identify
+    from .ident.records import load
     from .ident.report import write_report
     columns = {}
     for item in args.columns.split(',') if args.columns else []:
@@ -461,12 +462,14 @@ def build_parser() -> argparse.ArgumentParser:
     a.add_argument('--no-plots', action='store_true', help='numbers only')
     w = add('sweep', cmd_sweep, 'stability map over the delay tau and the initial angle theta0 (Figures 11-12), '
             'offline physics core, parallel and resumable')
-    w.add_argument('--config', default=str(REPO_ROOT / 'config' / 'fig9_new_gain_exponential.yaml'), help='base scenario (default %(default)s)')
+    w.add_argument('--config', default=str(REPO_ROOT / 'config' / 'fig9_new_gain_exponential.yaml'),
+                   help='base scenario (default %(default)s)')
     w.add_argument('--tau', default='0:0.14:0.005', help='delays [s], start:stop:step or a,b,c (default %(default)s)')
     w.add_argument('--theta0-deg', default='0:12:0.5', help='initial angles [deg] (default %(default)s)')
     w.add_argument('--duration', type=float, default=20.0, help='simulated seconds per cell (default %(default)s)')
     w.add_argument('--sensors', choices=('exact', 'config'), default='exact',
-                   help='exact states as in the paper\'s simulations, or the scenario\'s encoders (default %(default)s)')
+                   help='exact states as in the paper\'s simulations, or the scenario\'s encoders '
+                   '(default %(default)s)')
     w.add_argument('--smoothing', choices=('none', 'tanh'), default=None, help='override the friction smoothing')
     w.add_argument('--workers', type=int, default=None,
                    help='parallel cells (default: all cores offline, 1 with --ros)')

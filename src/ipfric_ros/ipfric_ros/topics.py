@@ -40,10 +40,11 @@ def latched_qos(depth: int = 1) -> QoSProfile:
 
 def run_topics() -> dict:
     """Every topic of a run: name -> (message class, ROS type name, latched)."""
-    from ipfric_msgs.msg import PlantState, SafetyEvent, VoltageCommand
     from rosgraph_msgs.msg import Clock
     from sensor_msgs.msg import JointState
     from std_msgs.msg import Float64MultiArray
+
+    from ipfric_msgs.msg import PlantState, SafetyEvent, VoltageCommand
     return {
         CLOCK: (Clock, 'rosgraph_msgs/msg/Clock', False),
         JOINT_STATES: (JointState, 'sensor_msgs/msg/JointState', False),

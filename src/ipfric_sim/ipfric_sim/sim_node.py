@@ -31,11 +31,7 @@ from array import array
 from collections import Counter
 
 import numpy as np
-
 from builtin_interfaces.msg import Time
-from ipfric_core.physics.closedloop import warm_up
-from ipfric_core.physics.params import ConfigError
-from ipfric_msgs.msg import PlantState, SafetyEvent, VoltageCommand
 from rclpy.duration import Duration
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
@@ -44,6 +40,9 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 
+from ipfric_core.physics.closedloop import warm_up
+from ipfric_core.physics.params import ConfigError
+from ipfric_msgs.msg import PlantState, SafetyEvent, VoltageCommand
 from ipfric_ros import topics
 from ipfric_ros.parameters import check_unknown, declare, declare_scenario
 from ipfric_ros.signals import StopRequest, node_process

@@ -16,6 +16,7 @@ import struct
 from dataclasses import dataclass, field
 from io import BytesIO
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from mcap.data_stream import ReadDataStream
@@ -79,7 +80,8 @@ TRUTH_FIELDS = ('x', 'theta', 'x_dot', 'theta_dot', 'friction_force', 'z', 'stuc
 # MCAP record opcodes used here, and what the compiled scanner does with a channel's messages.
 MAGIC = b'\x89MCAP0\r\n'
 OP_CHUNK, OP_MESSAGE, OP_DATA_END, OP_FOOTER = Opcode.CHUNK, Opcode.MESSAGE, Opcode.DATA_END, Opcode.FOOTER
-RECORDS = {Opcode.SCHEMA: Schema, Opcode.CHANNEL: Channel, Opcode.MESSAGE: Message, Opcode.METADATA: Metadata}
+RECORDS: dict[int, Any] = {Opcode.SCHEMA: Schema, Opcode.CHANNEL: Channel, Opcode.MESSAGE: Message,
+                           Opcode.METADATA: Metadata}
 SKIP, JOINTS, COMMAND, TRUTH, PYTHON = 0, 1, 2, 3, 4
 SCANNED = {'joint_states': JOINTS, 'voltage_command': COMMAND, 'plant_state': TRUTH}
 DECODED = ('safety_event', 'controller_gain')
@@ -206,7 +208,7 @@ class _Reader:
             self.decoders[ch.id] = self.factory.decoder_for(ch.message_encoding, self.schemas.get(ch.schema_id))
         m = self.decoders[ch.id](rec.data)
         topic = ch.topic.lstrip('/')
-        row = None
+        row: tuple | None = None
         if topic == 'joint_states':
             row, kind = (_stamp(m.header.stamp), m.position[0], m.position[1]), JOINTS
         elif topic == 'voltage_command':

@@ -89,8 +89,9 @@ def classify(t, x, theta, resolution=(4.54e-5, 1.534e-3), fallen_angle: float = 
     The larger of the two signals (in counts) then decides: growing if the second half
     of the window has over 1.25 times the peak-to-peak of the first; settled (still
     converging) if it has under half, or if the window holds under 1.5 periods
-    (a creep, not an oscillation); otherwise a limit cycle. Fallen: |theta| reached ``fallen_angle``, or the run ended on a
-    safety limit (``ended_fallen``: the pendulum fell or the cart hit the track end).
+    (a creep, not an oscillation); otherwise a limit cycle. Fallen: |theta| reached
+    ``fallen_angle``, or the run ended on a safety limit (``ended_fallen``: the pendulum
+    fell or the cart hit the track end).
     """
     t, x, theta = (np.asarray(a, float) for a in (t, x, theta))
     over = np.nonzero(np.abs(theta) >= fallen_angle)[0]

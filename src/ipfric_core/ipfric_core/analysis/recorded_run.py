@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .bagread import RunData, read_run
 from ..physics.encoder import ANGLE_RESOLUTION_RAD, CART_RESOLUTION_M
+from .bagread import RunData, read_run
 from .oscillation import classify
 from .plots import overlay_figure, run_figure
 

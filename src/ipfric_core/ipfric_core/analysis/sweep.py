@@ -11,16 +11,16 @@ import csv
 import math
 import os
 import sys
+from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import replace
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
 from ..physics.closedloop import run_closed_loop
-from .oscillation import CLASSES, classify
 from ..run.scenario import Scenario
+from .oscillation import CLASSES, classify
 
 FIELDS = ('tau_s', 'theta0_deg', 'class', 'transition_time_s', 'x_p2p_m', 'theta_p2p_rad', 'period_s')
 
@@ -67,8 +67,8 @@ def _ros_cell(scn: Scenario, cell_dir: Path, duration: float):
 
     import yaml
 
-    from .bagread import read_run
     from ..run.runner import run
+    from .bagread import read_run
     if cell_dir.exists():          # a cell interrupted before it reached cells.csv: run it again
         shutil.rmtree(cell_dir)
     cell_dir.mkdir(parents=True)
@@ -89,7 +89,7 @@ def _key(tau, theta0_deg) -> tuple:
 
 def load_cells(path: Path) -> dict:
     """Finished cells of an earlier (possibly interrupted) sweep; a torn last line is ignored."""
-    done = {}
+    done: dict[tuple, dict] = {}
     if not path.exists():
         return done
     with open(path, newline='') as fh:
@@ -97,7 +97,8 @@ def load_cells(path: Path) -> dict:
             try:
                 if row['class'] not in CLASSES:
                     continue
-                typed = {k: (None if row[k] in ('', None) else float(row[k])) for k in FIELDS if k != 'class'}
+                typed: dict[str, object] = {k: (None if row[k] in ('', None) else float(row[k]))
+                                            for k in FIELDS if k != 'class'}
                 typed['class'] = row['class']
                 done[_key(typed['tau_s'], typed['theta0_deg'])] = typed
             except (KeyError, TypeError, ValueError):

@@ -1,7 +1,9 @@
-"""Design on the physics (paper sections 3-5): linearization, LQR, Routh-Hurwitz, the critical delay, friction estimates from the appendix tables, the printed numbers.
+"""Design on the physics (paper sections 3-5): linearization, LQR, Routh-Hurwitz, the
+critical delay, friction estimates from the appendix tables, the printed numbers.
 
-Modules: critical_delay, estimation, linearize, lqr, paper, paperconfig, reports, stability. Every public name below is loaded from its module on
-first use, so importing the package stays cheap."""
+Modules: critical_delay, estimation, linearize, lqr, paper, paperconfig, reports, stability.
+Every public name below is loaded from its module on first use, so importing the package
+stays cheap."""
 from __future__ import annotations
 
 import importlib
@@ -51,7 +53,8 @@ _WHERE = {
     'static_coefficient': 'estimation',
 }
 
-__all__ = sorted(_WHERE) + ['critical_delay', 'estimation', 'linearize', 'lqr', 'paper', 'paperconfig', 'reports', 'stability']
+__all__ = sorted(_WHERE) + ['critical_delay', 'estimation', 'linearize', 'lqr', 'paper', 'paperconfig', 'reports',
+                            'stability']
 
 
 def __getattr__(name: str):

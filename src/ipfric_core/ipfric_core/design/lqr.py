@@ -8,8 +8,8 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
-from .linearize import jacobian
 from ..physics.params import FrictionParams, PlantParams
+from .linearize import jacobian
 
 
 def controllability_matrix(A, B) -> np.ndarray:
@@ -34,7 +34,7 @@ def controllable_basis(A, B, rtol: float = 1e-9):
     basis: list[np.ndarray] = []
     block = B
     for _ in range(n):
-        new = []
+        new: list[np.ndarray] = []
         for v in block.T:
             scale = np.linalg.norm(v)
             for q in basis + new:

@@ -4,7 +4,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..physics.params import ConfigError, FrictionParams, PlantParams, check_keys, check_number, Field, load_yaml
+from ..physics.params import ConfigError, Field, FrictionParams, PlantParams, check_keys, check_number, load_yaml
 
 REPO_ROOT = Path(__file__).resolve().parents[4]
 DEFAULT_CONFIG = REPO_ROOT / 'config' / 'paper.yaml'

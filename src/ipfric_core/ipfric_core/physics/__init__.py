@@ -1,7 +1,10 @@
-"""Physics of the rig (paper sections 2 and 6): parameters, friction laws, the plant, stick-slip integration, encoders and undeclared effects, the sampled controller and closed loop. Knows nothing of ROS, design or data.
+"""Physics of the rig (paper sections 2 and 6): parameters, friction laws, the plant,
+stick-slip integration, encoders and undeclared effects, the sampled controller and closed
+loop. Knows nothing of ROS, design or data.
 
-Modules: closedloop, compiled, controller, encoder, friction, params, plant, rig, simulate. Every public name below is loaded from its module on
-first use, so importing the package stays cheap."""
+Modules: closedloop, compiled, controller, encoder, friction, params, plant, rig, simulate.
+Every public name below is loaded from its module on first use, so importing the package
+stays cheap."""
 from __future__ import annotations
 
 import importlib
@@ -74,7 +77,8 @@ _WHERE = {
     'warm_up': 'closedloop',
 }
 
-__all__ = sorted(_WHERE) + ['closedloop', 'compiled', 'controller', 'encoder', 'friction', 'params', 'plant', 'rig', 'simulate']
+__all__ = sorted(_WHERE) + ['closedloop', 'compiled', 'controller', 'encoder', 'friction', 'params', 'plant', 'rig',
+                            'simulate']
 
 
 def __getattr__(name: str):

@@ -15,7 +15,8 @@ import numba
 _HERE = Path(__file__).resolve().parent
 _SOURCES = sorted(p for p in _HERE.parent.rglob('*.py') if '@compiled' in p.read_text())
 _KEY = hashlib.sha256(b''.join(p.read_bytes() for p in _SOURCES)).hexdigest()[:16]
-numba.config.CACHE_DIR = str(_HERE / '__pycache__' / f'numba-{_KEY}')
+numba.config.CACHE_DIR = str(  # type: ignore[attr-defined]  # set at numba's import
+    _HERE / '__pycache__' / f'numba-{_KEY}')
 
 
 def compiled(fn):

@@ -12,7 +12,6 @@ from collections import deque
 from .compiled import compiled
 
 
-
 def delay_samples(tau: float, dt: float) -> int:
     """Number of samples n with tau = n dt; raises ValueError if tau is not a multiple."""
     if not math.isfinite(tau) or tau < 0:
@@ -74,7 +73,7 @@ class StateFeedback:
         self.cutoff_hz = float(cutoff_hz)
         self.voltage_limit = float(voltage_limit)
         self.set_delay(delay)
-        self._last = None
+        self._last: tuple[float, float] | None = None
         self._vel = [0.0, 0.0]
 
     def set_delay(self, tau: float) -> None:
@@ -82,6 +81,7 @@ class StateFeedback:
         n = delay_samples(tau, self.dt)
         self.delay = tau
         old = list(getattr(self, '_history', []))
+        self._depth = n + 1
         self._history = deque(old[-(n + 1):], maxlen=n + 1)
         if old:
             while len(self._history) < n + 1:
@@ -102,7 +102,7 @@ class StateFeedback:
         """Voltage [V] for the sample whose encoder readings are ``x`` [m], ``theta`` [rad]."""
         est = self.estimate(x, theta)
         if not self._history:
-            self._history.extend([est] * self._history.maxlen)
+            self._history.extend([est] * self._depth)
         else:
             self._history.append(est)
         return feedback(self.gain, self._history[0], self.voltage_limit)

@@ -7,9 +7,10 @@ the value and what is allowed.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 import yaml
 
@@ -94,7 +95,7 @@ class PlantParams:
     beta: float = 7.682
 
     @classmethod
-    def from_dict(cls, data: Any, path: str = 'plant') -> 'PlantParams':
+    def from_dict(cls, data: Any, path: str = 'plant') -> PlantParams:
         data = check_keys(path, data, set(PLANT_FIELDS), set(PLANT_FIELDS))
         return cls(**{k: check_number(f'{path}.{k}', data[k], s) for k, s in PLANT_FIELDS.items()})
 
@@ -144,7 +145,7 @@ class FrictionParams:
     delta: float = 100.0
 
     @classmethod
-    def from_dict(cls, data: Any, path: str = 'friction') -> 'FrictionParams':
+    def from_dict(cls, data: Any, path: str = 'friction') -> FrictionParams:
         if not isinstance(data, Mapping):
             raise ConfigError(f'{path}: expected a mapping, got {type(data).__name__}')
         model = check_choice(f'{path}.model', data.get('model'), FRICTION_MODELS)
@@ -168,7 +169,7 @@ class FrictionParams:
             keep |= {'smoothing', 'delta'}
         return {k: v for k, v in asdict(self).items() if k in keep}
 
-    def replace(self, **changes) -> 'FrictionParams':
+    def replace(self, **changes) -> FrictionParams:
         data = asdict(self)
         data.update(changes)
         return FrictionParams(**data)

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import math
 
-
 from .compiled import compiled
 from .friction import Friction, bristle_rate, friction_force
 from .params import FrictionParams, PlantParams

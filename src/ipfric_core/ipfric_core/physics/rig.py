@@ -14,7 +14,6 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-
 from .compiled import compiled
 from .encoder import quantize
 from .plant import CartPendulum

@@ -23,11 +23,17 @@ from __future__ import annotations
 
 import math
 
-
 from .compiled import compiled
 from .friction import friction_force, holds, static_limit, sticks
-from .plant import (NO_EXTRA_FORCE, CartPendulum, held_force, motor_force, rates,
-                    stuck_theta_acceleration, undeclared_force)
+from .plant import (
+    NO_EXTRA_FORCE,
+    CartPendulum,
+    held_force,
+    motor_force,
+    rates,
+    stuck_theta_acceleration,
+    undeclared_force,
+)
 
 MAX_EVENTS = 64  # per substep; a guard, never reached in normal motion
 XTOL = 1e-13     # event time tolerance [s]

@@ -126,7 +126,7 @@ class RunResult:
     detail: str | None
     out: str
     bag: str
-    domain: int
+    domain: int | None
     samples: int | None = None
     sim_time_s: float | None = None
     wall_time_s: float | None = None
@@ -194,7 +194,7 @@ class Run:
         self.logs: dict[str, Path] = {}
         self.failures: list[str] = []
         self.interrupted = False
-        self._files = []
+        self._files: list = []
 
     # -- start -----------------------------------------------------------------------------
     def prepare(self) -> Path:

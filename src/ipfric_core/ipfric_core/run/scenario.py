@@ -37,15 +37,28 @@ parameters, nested again, to :func:`scenario_from_ros_params`).
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
+from ..design.lqr import design
 from ..physics.controller import StateFeedback, delay_samples
 from ..physics.encoder import ANGLE_RESOLUTION_RAD, CART_RESOLUTION_M
-from ..design.lqr import design
-from ..physics.params import (FRICTION_FIELDS, FRICTION_MODELS, PLANT_FIELDS, SMOOTHING, ConfigError, Field,
-                     FrictionParams, PlantParams, check_keys, check_number, check_choice, load_yaml)
+from ..physics.params import (
+    FRICTION_FIELDS,
+    FRICTION_MODELS,
+    PLANT_FIELDS,
+    SMOOTHING,
+    ConfigError,
+    Field,
+    FrictionParams,
+    PlantParams,
+    check_choice,
+    check_keys,
+    check_number,
+    load_yaml,
+)
 from ..physics.plant import CartPendulum
 from ..physics.rig import PlantTruth, Rig
 
@@ -136,7 +149,8 @@ def parse_sim(data: Mapping, path: str = 'sim_node.ros__parameters'):
     """(SimSettings, PlantParams, FrictionParams, PlantTruth) from a nested mapping."""
     known = set(SIM_FIELDS) | {'time_mode', 'plant', 'friction', 'plant_truth', 'use_sim_time'}
     data = check_keys(path, data, known, {'plant', 'friction'})
-    values = {k: check_number(f'{path}.{k}', data[k], spec) for k, (_, spec) in SIM_FIELDS.items() if k in data}
+    values: dict[str, Any] = {k: check_number(f'{path}.{k}', data[k], spec)
+                              for k, (_, spec) in SIM_FIELDS.items() if k in data}
     if 'watchdog_samples' in values:
         values['watchdog_samples'] = int(values['watchdog_samples'])
     values['time_mode'] = check_choice(f'{path}.time_mode', data.get('time_mode', 'lockstep'), TIME_MODES)
@@ -144,7 +158,8 @@ def parse_sim(data: Mapping, path: str = 'sim_node.ros__parameters'):
     plant = PlantParams.from_dict(data['plant'], f'{path}.plant')
     friction = FrictionParams.from_dict(data['friction'], f'{path}.friction')
     tdata = check_keys(f'{path}.plant_truth', data.get('plant_truth', {}) or {}, set(TRUTH_FIELDS), set())
-    tvals = {k: check_number(f'{path}.plant_truth.{k}', tdata[k], s) for k, s in TRUTH_FIELDS.items() if k in tdata}
+    tvals: dict[str, Any] = {k: check_number(f'{path}.plant_truth.{k}', tdata[k], s)
+                             for k, s in TRUTH_FIELDS.items() if k in tdata}
     if 'noise_seed' in tvals:
         tvals['noise_seed'] = int(tvals['noise_seed'])
     truth = PlantTruth(**tvals)
@@ -159,7 +174,7 @@ def parse_sim(data: Mapping, path: str = 'sim_node.ros__parameters'):
 def parse_controller(data: Mapping, path: str = 'controller_node.ros__parameters') -> ControllerSettings:
     known = set(CONTROLLER_FIELDS) | {'gain_source', 'gain', 'plant', 'design_friction', 'Q', 'use_sim_time'}
     data = check_keys(path, data, known, set())
-    values = {k: check_number(f'{path}.{k}', data[k], spec)
+    values: dict[str, Any] = {k: check_number(f'{path}.{k}', data[k], spec)
               for k, (_, spec) in CONTROLLER_FIELDS.items() if k in data}
     source = check_choice(f'{path}.gain_source', data.get('gain_source', 'yaml'), GAIN_SOURCES)
     gain = design_friction = None
@@ -203,6 +218,7 @@ class Scenario:
         c = self.controller
         if c.gain is not None:
             return list(c.gain)
+        assert c.design_friction is not None  # parse_controller requires it without a gain
         return design(c.plant, c.design_friction, c.Q, c.R).gain[:4].tolist()
 
     def make_rig(self) -> Rig:
