@@ -15,14 +15,21 @@ def cli(*args):
     return out
 
 
-def test_design_json_side_by_side():
-    out = cli('design', '--json')
+def test_design_json_side_by_side(data_dir):
+    out = cli('design', '--json', '--data', str(data_dir))
     assert out.returncode == 0, out.stderr
     rep = json.loads(out.stdout)
     for name in ('viscous', 'exponential', 'dynamic'):
         assert rep['gains'][name]['max_rel_diff'] < 3e-5
     assert round(rep['friction_estimates']['mu_s']['ipfric'], 5) == 0.08328
     assert rep['controllability_rank']['dynamic'] == {'rank': 4, 'n_states': 5}
+
+
+def test_design_without_the_data_gives_the_gains_and_says_what_is_left_out(tmp_path):
+    out = cli('design', '--data', str(tmp_path / 'nowhere'))
+    assert out.returncode == 0, out.stderr
+    assert 'exponential model, eq. (23)' in out.stdout and 'Table 6' not in out.stdout
+    assert f'{tmp_path / "nowhere" / "paper"} is absent' in out.stderr
 
 
 def test_stability_json_side_by_side():
