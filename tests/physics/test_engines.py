@@ -69,6 +69,22 @@ def test_noise_needs_the_python_engine():
         run_closed_loop(rig, s.make_controller(), 0.1, engine='compiled')
 
 
+def test_rig_and_controller_hand_over_their_settings_as_frozen_specs():
+    s = replace(scenario('delay_exponential_tau20ms'), truth=EFFECTS)
+    rig, ctl = s.make_rig(), s.make_controller()
+    r, f = rig.loop_spec(), ctl.loop_spec()
+    assert r.drive == (0.1, 8.0, 2.0)                  # input delay 2 ms = 2 samples at 1 kHz
+    assert r.sensors == (1e-3, 1e-3, 1e-4) and r.state[1] == s.sim.theta0 and r.mode == (0.0, 0.0, 0.0)
+    assert f.control[2] == 20.0 and f.control[1] == 0.001 and f.gain == ctl.gain   # tau 20 ms = 20 samples
+    with pytest.raises(AttributeError):
+        r.dt = 0.002
+    assert not ctl.started
+    ctl.update(0.0, 0.01)
+    assert ctl.started
+    with pytest.raises(ValueError, match='controller has already been updated'):
+        run_closed_loop(s.make_rig(), ctl, 0.1, engine='compiled')
+
+
 def test_compiled_engine_matches_the_scipy_reference():
     """Figure 7 with exact sensors: trajectory within 2e-5 m / 1e-4 rad over 3 s of stick-slip
     (LSODA rtol 1e-10 against RK4 0.25 ms with located events)."""

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from dataclasses import dataclass
 
 from .compiled import compiled
 
@@ -42,6 +43,18 @@ def feedback(gain, state, limit: float) -> float:
     """V = sat(K . s) [V], |V| <= ``limit``."""
     v = gain[0] * state[0] + gain[1] * state[1] + gain[2] * state[2] + gain[3] * state[3]
     return max(-limit, min(limit, v))
+
+
+@dataclass(frozen=True)
+class FeedbackSpec:
+    """A :class:`StateFeedback` as numbers, what the compiled closed loop takes.
+
+    gain : K (x, theta, x', theta') [V/m, V/rad, V s/m, V s/rad]
+    control : (filter pole a, sample period [s], delay [samples], voltage limit [V])
+    """
+
+    gain: tuple
+    control: tuple
 
 
 class StateFeedback:
@@ -86,6 +99,17 @@ class StateFeedback:
         if old:
             while len(self._history) < n + 1:
                 self._history.appendleft(self._history[0])
+
+    @property
+    def started(self) -> bool:
+        """True once a measurement has been pushed (the filter and history hold state)."""
+        return self._last is not None
+
+    def loop_spec(self) -> FeedbackSpec:
+        """The controller's settings as numbers (see :class:`FeedbackSpec`)."""
+        return FeedbackSpec(gain=tuple(self.gain),
+                            control=(filter_coefficient(self.cutoff_hz, self.dt), float(self.dt),
+                                     float(self._depth - 1), float(self.voltage_limit)))
 
     def estimate(self, x: float, theta: float) -> tuple[float, float, float, float]:
         """Push one measurement; return the current state estimate."""

@@ -99,6 +99,32 @@ def sensor_reading(x, theta, bias_x, bias_theta, noise_x, noise_theta, resolutio
             quantize(theta + bias_theta + noise_theta, resolution[1]))
 
 
+@dataclass(frozen=True)
+class RigSpec:
+    """A :class:`Rig` as numbers, what the compiled closed loop takes (SI units).
+
+    plant, friction, extra_force : the vectors of ``plant.rates``
+    state, mode : the integrator's (x, theta, x', theta', z) and (stuck, direction, events)
+    substep, dt : largest RK4 step and sample period [s]
+    resolution : encoder counts (cart [m], angle [rad])
+    sensors : (bias x [m], bias theta [rad], backlash [m])
+    drive : (deadzone [V], saturation [V], input delay [samples])
+    limits : (track limit [m], fallen angle [rad])
+    """
+
+    plant: tuple
+    friction: tuple
+    extra_force: tuple
+    state: tuple
+    mode: tuple
+    substep: float
+    dt: float
+    resolution: tuple
+    sensors: tuple
+    drive: tuple
+    limits: tuple
+
+
 class Rig:
     """Samples the true plant at period ``dt`` [s] with zero-order-hold voltage.
 
@@ -160,6 +186,16 @@ class Rig:
                 'friction_force': self.sim.friction_force(self.voltage_applied),
                 'z': s[4] if len(s) == 5 else 0.0, 'stuck': self.sim.stuck,
                 'voltage_applied': self.voltage_applied}
+
+    def loop_spec(self) -> RigSpec:
+        """The rig's settings and current state as numbers (see :class:`RigSpec`)."""
+        e, sim = self.effects, self.sim
+        return RigSpec(plant=sim.model.vector, friction=sim.model.friction.vector, extra_force=sim.extra_force,
+                       state=sim.state_tuple, mode=sim.mode, substep=sim.substep, dt=float(self.dt),
+                       resolution=(float(self.resolution[0]), float(self.resolution[1])),
+                       sensors=(float(e.bias_x_m), float(e.bias_theta_rad), float(e.backlash_m)),
+                       drive=(float(e.deadzone_V), float(e.saturation_V), float(len(self._pending))),
+                       limits=(float(self.track_limit), float(self.fallen_angle)))
 
     def limit_violation(self):
         """None, or (code, detail) when the track or fallen limit is crossed."""

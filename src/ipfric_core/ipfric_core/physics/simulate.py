@@ -237,6 +237,16 @@ class Simulator:
         return list(self._s[:self.model.n_states])
 
     @property
+    def state_tuple(self) -> tuple:
+        """The integrator's full state (x, theta, x', theta', z) [SI], z = 0 for laws without it."""
+        return self._s
+
+    @property
+    def mode(self) -> tuple:
+        """The integrator's mode (stuck 0/1, direction of motion of a sticking law, events)."""
+        return self._mode
+
+    @property
     def stuck(self) -> bool:
         """True while static friction holds the cart."""
         return self._mode[0] != 0.0
