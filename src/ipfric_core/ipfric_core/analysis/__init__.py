@@ -43,7 +43,6 @@ _WHERE = {
     'run_name': 'recorded_run',
     'spectral_period': 'oscillation',
     'stability_map': 'plots',
-    'sweep': 'sweep',
     'threshold_angle': 'sweep',
     'transition_figure': 'plots',
 }

@@ -8,9 +8,12 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
-from ..physics.params import FrictionParams, PlantParams
+from ..physics.params import Field, FrictionParams, PlantParams
 from .linearize import jacobian
 
+#: bounds of the LQR weights: Q on (x, theta, x', theta') and R on the voltage
+STATE_WEIGHT = Field('', 0.0, 1e12, 'LQR state weight')
+CONTROL_WEIGHT = Field('', 0.0, 1e12, 'LQR control weight', lo_open=True)
 
 def controllability_matrix(A, B) -> np.ndarray:
     """[B, AB, ..., A^(n-1) B]."""

@@ -56,7 +56,6 @@ _WHERE = {
     'friction_vector': 'effects',
     'identified_friction': 'redesign',
     'identified_truth': 'redesign',
-    'identify': 'identify',
     'identify_steady': 'identify',
     'input_effects': 'effects',
     'load': 'records',

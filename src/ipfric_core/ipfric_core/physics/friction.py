@@ -18,7 +18,7 @@ must cancel stays below mu_s F_N) is a property of the motion, handled by
 :mod:`ipfric_core.physics.simulate` with :func:`holds`.
 
 Each law is written once, as a scalar function of a parameter vector ``fp``
-(:func:`parameter_vector`) compiled by numba: :class:`Friction` calls these functions
+(:func:`friction_vector`) compiled by numba: :class:`Friction` calls these functions
 from Python and the compiled integrator and closed loop call the very same ones.
 """
 from __future__ import annotations
@@ -33,11 +33,11 @@ from .params import FrictionParams
 #: Codes of the friction models in a parameter vector (floats, so the vector is uniform).
 MODEL_CODES = {'viscous': 0.0, 'coulomb': 1.0, 'exponential': 2.0, 'dynamic': 3.0}
 VISCOUS, COULOMB, EXPONENTIAL, DYNAMIC = 0.0, 1.0, 2.0, 3.0
-# Positions in the parameter vector of :func:`parameter_vector`.
-MODEL, SMOOTH, EPS, MU_S, MU_C, V_S, GAMMA, SIGMA0, SIGMA1, DELTA, FN = range(11)
+#: Positions in the parameter vector ``fp`` of :func:`friction_vector`.
+FP_MODEL, FP_SMOOTH, FP_EPS, FP_MU_S, FP_MU_C, FP_V_S, FP_GAMMA, FP_SIGMA0, FP_SIGMA1, FP_DELTA, FP_FN = range(11)
 
 
-def parameter_vector(params: FrictionParams, normal_force: float) -> tuple:
+def friction_vector(params: FrictionParams, normal_force: float) -> tuple:
     """The law as a tuple of 11 floats, the argument ``fp`` of the scalar functions below.
 
     (model code, tanh smoothing 0/1, eps, mu_s, mu_c, v_s, gamma, sigma0, sigma1, delta, F_N).
@@ -67,13 +67,13 @@ def static_friction(applied: float, limit: float) -> float:
 @compiled
 def sticks(fp) -> bool:
     """True when the law has a sticking phase: coulomb or exponential without smoothing."""
-    return (fp[MODEL] == COULOMB or fp[MODEL] == EXPONENTIAL) and fp[SMOOTH] == 0.0
+    return (fp[FP_MODEL] == COULOMB or fp[FP_MODEL] == EXPONENTIAL) and fp[FP_SMOOTH] == 0.0
 
 
 @compiled
 def static_limit(fp) -> float:
     """Largest force static friction can hold, mu_s F_N [N] (eq. 5); 0 for viscous."""
-    return 0.0 if fp[MODEL] == VISCOUS else fp[MU_S] * fp[FN]
+    return 0.0 if fp[FP_MODEL] == VISCOUS else fp[FP_MU_S] * fp[FP_FN]
 
 
 @compiled
@@ -85,11 +85,11 @@ def holds(fp, applied: float) -> bool:
 @compiled
 def sliding_level(fp, v: float) -> float:
     """Magnitude of the velocity-dependent sliding friction [N]: 0, mu_c F_N or g(v)."""
-    if fp[MODEL] == VISCOUS:
+    if fp[FP_MODEL] == VISCOUS:
         return 0.0
-    if fp[MODEL] == COULOMB:
-        return fp[MU_C] * fp[FN]
-    return stribeck_level(v, fp[MU_S], fp[MU_C], fp[V_S], fp[GAMMA], fp[FN])
+    if fp[FP_MODEL] == COULOMB:
+        return fp[FP_MU_C] * fp[FP_FN]
+    return stribeck_level(v, fp[FP_MU_S], fp[FP_MU_C], fp[FP_V_S], fp[FP_GAMMA], fp[FP_FN])
 
 
 @compiled
@@ -99,26 +99,27 @@ def friction_force(fp, v: float, z: float, direction: float) -> float:
     ``direction`` (+1 or -1) replaces sgn(v) for the sticking laws, so that a step that
     ends exactly at v = 0 keeps the sign of the motion it integrates; 0 = use sgn(v).
     """
-    model = fp[MODEL]
+    model = fp[FP_MODEL]
     if model == VISCOUS:
-        return -fp[EPS] * v
+        return -fp[FP_EPS] * v
     if model == DYNAMIC:
-        return -(fp[SIGMA1] + fp[EPS]) * v - fp[SIGMA0] * z * (1.0 - fp[SIGMA1] * abs(v) / sliding_level(fp, v))
-    if fp[SMOOTH] != 0.0:
-        sign = math.tanh(fp[DELTA] * v)
+        return (-(fp[FP_SIGMA1] + fp[FP_EPS]) * v
+                - fp[FP_SIGMA0] * z * (1.0 - fp[FP_SIGMA1] * abs(v) / sliding_level(fp, v)))
+    if fp[FP_SMOOTH] != 0.0:
+        sign = math.tanh(fp[FP_DELTA] * v)
     elif direction != 0.0:
         sign = direction
     else:
         sign = math.copysign(1.0, v) if v != 0.0 else 0.0
-    return -sliding_level(fp, v) * sign - fp[EPS] * v
+    return -sliding_level(fp, v) * sign - fp[FP_EPS] * v
 
 
 @compiled
 def bristle_rate(fp, v: float, z: float) -> float:
     """Bristle deflection rate z' [m/s], eq. (10); 0 for the other laws."""
-    if fp[MODEL] != DYNAMIC:
+    if fp[FP_MODEL] != DYNAMIC:
         return 0.0
-    return v - fp[SIGMA0] * abs(v) * z / sliding_level(fp, v)
+    return v - fp[FP_SIGMA0] * abs(v) * z / sliding_level(fp, v)
 
 
 @compiled
@@ -142,7 +143,7 @@ def bristle_path(fp, v, dt: float):
     zk = 0.0
     for k in range(len(v)):
         if v[k] != 0.0:
-            a = fp[SIGMA0] * abs(v[k]) / sliding_level(fp, v[k])
+            a = fp[FP_SIGMA0] * abs(v[k]) / sliding_level(fp, v[k])
             zss = v[k] / a
             zk = zss + (zk - zss) * math.exp(-a * dt)
         z[k] = zk
@@ -167,7 +168,7 @@ class Friction:
         self.model = params.model
         self.smooth = params.smoothing == 'tanh'
         #: The law as the parameter vector of the scalar functions.
-        self.vector = parameter_vector(params, self.normal_force)
+        self.vector = friction_vector(params, self.normal_force)
         #: True when the law has a sticking phase (exact stick-slip).
         self.sticks = sticks(self.vector)
         #: Number of internal friction states (the bristle deflection z).

@@ -42,7 +42,7 @@ from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 from typing import Any
 
-from ..design.lqr import design
+from ..design.lqr import CONTROL_WEIGHT, STATE_WEIGHT, design
 from ..physics.controller import StateFeedback, delay_samples
 from ..physics.encoder import ANGLE_RESOLUTION_RAD, CART_RESOLUTION_M
 from ..physics.params import (
@@ -80,7 +80,7 @@ SIM_FIELDS = {
     'cart_resolution': (CART_RESOLUTION_M, Field('m', 0.0, 1.0, 'cart encoder count (0 = exact)')),
     'angle_resolution': (ANGLE_RESOLUTION_RAD, Field('rad', 0.0, 1.0, 'angle encoder count (0 = exact)')),
 }
-TRUTH_FIELDS = {
+PLANT_TRUTH_FIELDS = {
     'cogging_N': Field('N', -100.0, 100.0, 'amplitude of the position-periodic force'),
     'cogging_period_m': Field('m', 0.0, 10.0, 'period of the cogging force', lo_open=True),
     'deadzone_V': Field('V', 0.0, 100.0, 'input deadzone'),
@@ -99,10 +99,9 @@ CONTROLLER_FIELDS = {
     'delay': (0.0, Field('s', 0.0, 10.0, 'artificial feedback delay tau, eq. (26), a multiple of the sample period')),
     'cutoff_hz': (20.0, Field('Hz', 0.0, 1e4, 'velocity filter corner (0 = raw difference)')),
     'voltage_limit': (10.0, Field('V', 0.0, 1e3, 'command saturation', lo_open=True)),
-    'R': (1.0, Field('', 0.0, 1e12, 'LQR control weight', lo_open=True)),
+    'R': (1.0, CONTROL_WEIGHT),
 }
 DEFAULT_Q = [5000.0, 3000.0, 20.0, 20.0]
-WEIGHT = Field('', 0.0, 1e12, 'LQR state weight')
 GAIN = Field('V per SI unit', -1e6, 1e6, 'state feedback gain')
 
 
@@ -157,9 +156,9 @@ def parse_sim(data: Mapping, path: str = 'sim_node.ros__parameters'):
     sim = SimSettings(**values)
     plant = PlantParams.from_dict(data['plant'], f'{path}.plant')
     friction = FrictionParams.from_dict(data['friction'], f'{path}.friction')
-    tdata = check_keys(f'{path}.plant_truth', data.get('plant_truth', {}) or {}, set(TRUTH_FIELDS), set())
+    tdata = check_keys(f'{path}.plant_truth', data.get('plant_truth', {}) or {}, set(PLANT_TRUTH_FIELDS), set())
     tvals: dict[str, Any] = {k: check_number(f'{path}.plant_truth.{k}', tdata[k], s)
-                             for k, s in TRUTH_FIELDS.items() if k in tdata}
+                             for k, s in PLANT_TRUTH_FIELDS.items() if k in tdata}
     if 'noise_seed' in tvals:
         tvals['noise_seed'] = int(tvals['noise_seed'])
     truth = PlantTruth(**tvals)
@@ -191,7 +190,7 @@ def parse_controller(data: Mapping, path: str = 'controller_node.ros__parameters
     Q = data.get('Q', DEFAULT_Q)
     if not isinstance(Q, (list, tuple)) or len(Q) != 4:
         raise ConfigError(f'{path}.Q: expected 4 weights on (x, theta, x\', theta\'), got {Q!r}')
-    Q = tuple(check_number(f'{path}.Q[{i}]', q, WEIGHT) for i, q in enumerate(Q))
+    Q = tuple(check_number(f'{path}.Q[{i}]', q, STATE_WEIGHT) for i, q in enumerate(Q))
     settings = ControllerSettings(gain_source=source, gain=gain, plant=plant, design_friction=design_friction,
                                   Q=Q, **values)
     try:
@@ -279,7 +278,7 @@ class Scenario:
             plant('plant')
             friction('friction', FrictionParams())
             for f in fields(PlantTruth):
-                num(f'plant_truth.{f.name}', f.default, TRUTH_FIELDS[f.name])
+                num(f'plant_truth.{f.name}', f.default, PLANT_TRUTH_FIELDS[f.name])
         elif node == 'controller_node':
             for k, (default, spec) in CONTROLLER_FIELDS.items():
                 num(k, default, spec)
