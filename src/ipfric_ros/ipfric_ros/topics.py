@@ -9,18 +9,21 @@ from __future__ import annotations
 
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-CLOCK = '/clock'
-JOINT_STATES = 'joint_states'
-PLANT_STATE = 'plant_state'
-VOLTAGE_COMMAND = 'voltage_command'
-SAFETY_EVENT = 'safety_event'
-CONTROLLER_GAIN = 'controller_gain'
+# the names are defined once in ipfric_core.constants (the offline analysis reads them too)
+from ipfric_core.constants import (
+    CLOCK,
+    CONTROLLER_GAIN,
+    JOINT_NAMES,
+    JOINT_STATES,
+    PLANT_STATE,
+    SAFETY_EVENT,
+    TERMINAL_EVENTS,
+    VOLTAGE_COMMAND,
+)
 
-#: JointState names of the two encoders, in this order.
-JOINT_NAMES = ('cart', 'pendulum')
-
-#: SafetyEvent codes that end a run.
-TERMINAL_EVENTS = ('END', 'TRACK_LIMIT', 'FALLEN', 'ABORT')
+__all__ = ['CLOCK', 'CONTROLLER_GAIN', 'DATA_DEPTH', 'JOINT_NAMES', 'JOINT_STATES', 'PLANT_STATE', 'RECORD_DEPTH',
+           'SAFETY_EVENT', 'TERMINAL_EVENTS', 'VOLTAGE_COMMAND', 'data_qos', 'latched_qos', 'run_topics',
+           'stamp_of_sample', 'stamp_to_ns']
 
 DATA_DEPTH = 1000
 RECORD_DEPTH = 10000

@@ -26,6 +26,7 @@ from mcap.records import Channel, Chunk, Message, Metadata, Schema
 from mcap.stream_reader import get_chunk_data_stream
 from mcap_ros2.decoder import DecoderFactory
 
+from ..constants import CONTROLLER_GAIN, JOINT_STATES, PLANT_STATE, SAFETY_EVENT, VOLTAGE_COMMAND
 from ..physics.compiled import compiled
 from ..physics.params import ConfigError
 
@@ -83,8 +84,8 @@ OP_CHUNK, OP_MESSAGE, OP_DATA_END, OP_FOOTER = Opcode.CHUNK, Opcode.MESSAGE, Opc
 RECORDS: dict[int, Any] = {Opcode.SCHEMA: Schema, Opcode.CHANNEL: Channel, Opcode.MESSAGE: Message,
                            Opcode.METADATA: Metadata}
 SKIP, JOINTS, COMMAND, TRUTH, PYTHON = 0, 1, 2, 3, 4
-SCANNED = {'joint_states': JOINTS, 'voltage_command': COMMAND, 'plant_state': TRUTH}
-DECODED = ('safety_event', 'controller_gain')
+SCANNED = {JOINT_STATES: JOINTS, VOLTAGE_COMMAND: COMMAND, PLANT_STATE: TRUTH}
+DECODED = (SAFETY_EVENT, CONTROLLER_GAIN)
 # scanner status
 END, RECORD, FULL, CUT = 0, 1, 2, 3
 
@@ -209,15 +210,15 @@ class _Reader:
         m = self.decoders[ch.id](rec.data)
         topic = ch.topic.lstrip('/')
         row: tuple | None = None
-        if topic == 'joint_states':
+        if topic == JOINT_STATES:
             row, kind = (_stamp(m.header.stamp), m.position[0], m.position[1]), JOINTS
-        elif topic == 'voltage_command':
+        elif topic == VOLTAGE_COMMAND:
             row, kind = (_stamp(m.measurement_stamp), m.voltage), COMMAND
-        elif topic == 'plant_state':
+        elif topic == PLANT_STATE:
             row, kind = (_stamp(m.header.stamp),) + tuple(float(getattr(m, k)) for k in TRUTH_FIELDS), TRUTH
-        elif topic == 'safety_event':
+        elif topic == SAFETY_EVENT:
             self.events.append((_stamp(m.header.stamp), m.code, m.detail))
-        elif topic == 'controller_gain':
+        elif topic == CONTROLLER_GAIN:
             self.gain = list(m.data)
         if row is not None:
             self._grow(kind - 1)
@@ -280,7 +281,7 @@ def read_run(path: str | Path, keep=tuple(SCANNED)) -> RunData:
     plant_state); the others are only counted and their arrays left empty.
     """
     f = mcap_file(path)
-    r = _Reader(set(keep) | {'joint_states'})
+    r = _Reader(set(keep) | {JOINT_STATES})
     with open(f, 'rb') as fh:
         try:
             detail = r.read(fh)

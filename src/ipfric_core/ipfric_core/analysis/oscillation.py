@@ -10,6 +10,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from ..constants import ANGLE_RESOLUTION_RAD, CART_RESOLUTION_M, FALLEN_ANGLE_RAD
+
 CLASSES = ('settled', 'limit_cycle', 'growing', 'fallen')
 
 
@@ -78,7 +80,7 @@ def spectral_period(t: np.ndarray, y: np.ndarray) -> float | None:
     return float(1.0 / f) if f > 0 else None
 
 
-def classify(t, x, theta, resolution=(4.54e-5, 1.534e-3), fallen_angle: float = math.radians(30.0),
+def classify(t, x, theta, resolution=(CART_RESOLUTION_M, ANGLE_RESOLUTION_RAD), fallen_angle: float = FALLEN_ANGLE_RAD,
              ended_fallen: bool = False, window: float = 10.0) -> Oscillation:
     """Classify a run from its samples.
 

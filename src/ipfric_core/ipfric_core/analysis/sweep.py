@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..constants import DURATION, LIMITS
 from ..physics.closedloop import run_closed_loop
 from ..run.scenario import Scenario
 from .oscillation import CLASSES, classify
@@ -40,7 +41,7 @@ def classify_samples(scn: Scenario, t, x, theta, fell: bool, window: float = 10.
 def classify_run(scn: Scenario, duration: float, window: float = 10.0):
     """Run ``scn`` offline for ``duration`` [s]; (its Oscillation from the measured positions, the Trajectory)."""
     tr = run_closed_loop(scn.make_rig(), scn.make_controller(), duration)
-    return classify_samples(scn, tr.t, tr.measured[:, 0], tr.measured[:, 1], tr.end_reason != 'duration',
+    return classify_samples(scn, tr.t, tr.measured[:, 0], tr.measured[:, 1], tr.end_reason != DURATION,
                             window), tr
 
 
@@ -80,7 +81,7 @@ def _ros_cell(scn: Scenario, cell_dir: Path, duration: float):
     if res.exit_code != 0:
         raise RuntimeError(f'ROS run of {cell_dir.name} failed:\n{res.summary()}')
     bag = read_run(res.bag)
-    return bag.t, bag.x, bag.theta, bag.end_reason in ('FALLEN', 'TRACK_LIMIT')
+    return bag.t, bag.x, bag.theta, bag.end_reason in LIMITS
 
 
 def _key(tau, theta0_deg) -> tuple:

@@ -11,8 +11,6 @@ import importlib
 
 #: public name -> module that defines it
 _WHERE = {
-    'ANGLE_RESOLUTION_RAD': 'encoder',
-    'CART_RESOLUTION_M': 'encoder',
     'CartPendulum': 'plant',
     'ConfigError': 'params',
     'END_REASONS': 'closedloop',

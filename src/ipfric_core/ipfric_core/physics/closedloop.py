@@ -17,13 +17,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..constants import DURATION, FALLEN, TRACK_LIMIT
 from .compiled import compiled
 from .controller import StateFeedback, feedback, filtered_rate
 from .rig import Rig, input_effects, play, sensor_reading
 from .simulate import advance, friction_now
 
 ENGINES = ('auto', 'python', 'compiled')
-END_REASONS = ('duration', 'FALLEN', 'TRACK_LIMIT')
+#: how an offline run ends, by the compiled engine's code 0, 1, 2
+END_REASONS = (DURATION, FALLEN, TRACK_LIMIT)
 
 
 @dataclass
@@ -83,7 +85,7 @@ def warm_up(scenario) -> None:
 
 
 def _run_python(rig, controller, n, t, st, meas, volt, fric, stuck):
-    reason = 'duration'
+    reason = DURATION
     k = 0
     for k in range(n):
         mx, mth = rig.measure()

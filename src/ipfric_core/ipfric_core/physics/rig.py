@@ -14,6 +14,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from ..constants import FALLEN, FALLEN_ANGLE_RAD, TRACK_LIMIT, TRACK_LIMIT_M
 from .compiled import compiled
 from .encoder import quantize
 from .plant import CartPendulum
@@ -140,8 +141,8 @@ class Rig:
     """
 
     def __init__(self, model: CartPendulum, truth: PlantTruth, state0, dt: float,
-                 resolution=(0.0, 0.0), track_limit: float = 0.4,
-                 fallen_angle: float = math.radians(30.0)):
+                 resolution=(0.0, 0.0), track_limit: float = TRACK_LIMIT_M,
+                 fallen_angle: float = FALLEN_ANGLE_RAD):
         self.effects = truth
         self.dt = dt
         self.resolution = resolution
@@ -201,9 +202,9 @@ class Rig:
         """None, or (code, detail) when the track or fallen limit is crossed."""
         x, th = self.sim.state[0], self.sim.state[1]
         if not (math.isfinite(x) and math.isfinite(th)):
-            return 'FALLEN', 'state is not finite'
+            return FALLEN, 'state is not finite'
         if abs(th) > self.fallen_angle:
-            return 'FALLEN', f'|theta| = {abs(th):.3f} rad > {self.fallen_angle:.3f} rad'
+            return FALLEN, f'|theta| = {abs(th):.3f} rad > {self.fallen_angle:.3f} rad'
         if abs(x) > self.track_limit:
-            return 'TRACK_LIMIT', f'|x| = {abs(x):.3f} m > {self.track_limit:.3f} m'
+            return TRACK_LIMIT, f'|x| = {abs(x):.3f} m > {self.track_limit:.3f} m'
         return None

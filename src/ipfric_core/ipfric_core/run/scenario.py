@@ -42,9 +42,9 @@ from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 from typing import Any
 
+from ..constants import ANGLE_RESOLUTION_RAD, CART_RESOLUTION_M, FALLEN_ANGLE_RAD, TRACK_LIMIT_M
 from ..design.lqr import CONTROL_WEIGHT, STATE_WEIGHT, design
 from ..physics.controller import StateFeedback, delay_samples
-from ..physics.encoder import ANGLE_RESOLUTION_RAD, CART_RESOLUTION_M
 from ..physics.params import (
     FRICTION_FIELDS,
     FRICTION_MODELS,
@@ -74,8 +74,8 @@ SIM_FIELDS = {
                                    integer=True)),
     'voltage_max': (10.0, Field('V', 0.0, 1e3, 'largest accepted command', lo_open=True)),
     'theta0': (0.02, Field('rad', -1.0, 1.0, 'initial angle from upright, eq. (30)')),
-    'track_limit': (0.4, Field('m', 0.0, 10.0, 'end the run beyond |x|', lo_open=True)),
-    'fallen_angle': (math.radians(30.0), Field('rad', 0.0, math.pi, 'end the run beyond |theta|',
+    'track_limit': (TRACK_LIMIT_M, Field('m', 0.0, 10.0, 'end the run beyond |x|', lo_open=True)),
+    'fallen_angle': (FALLEN_ANGLE_RAD, Field('rad', 0.0, math.pi, 'end the run beyond |theta|',
                                                lo_open=True)),
     'cart_resolution': (CART_RESOLUTION_M, Field('m', 0.0, 1.0, 'cart encoder count (0 = exact)')),
     'angle_resolution': (ANGLE_RESOLUTION_RAD, Field('rad', 0.0, 1.0, 'angle encoder count (0 = exact)')),
@@ -114,8 +114,8 @@ class SimSettings:
     watchdog_samples: int = 50
     voltage_max: float = 10.0
     theta0: float = 0.02
-    track_limit: float = 0.4
-    fallen_angle: float = math.radians(30.0)
+    track_limit: float = TRACK_LIMIT_M
+    fallen_angle: float = FALLEN_ANGLE_RAD
     cart_resolution: float = CART_RESOLUTION_M
     angle_resolution: float = ANGLE_RESOLUTION_RAD
 
