@@ -95,9 +95,9 @@ class StateFeedback:
         self.delay = tau
         old = list(getattr(self, '_history', []))
         self._depth = n + 1
-        self._history = deque(old[-(n + 1):], maxlen=n + 1)
+        self._history = deque(old[-self._depth:], maxlen=self._depth)
         if old:
-            while len(self._history) < n + 1:
+            while len(self._history) < self._depth:
                 self._history.appendleft(self._history[0])
 
     @property
