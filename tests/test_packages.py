@@ -1,5 +1,6 @@
 """The layer subpackages: each public name means one thing, and no layer imports a later one."""
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -40,3 +41,16 @@ for m in pkgutil.iter_modules(pkg.__path__):
 print(json.dumps(sorted({{n.split('.')[1] for n in sys.modules if n.startswith('ipfric_core.')}})))
 ''')
     assert not set(json.loads(loaded)) & set(later), loaded
+
+
+def test_the_readme_maps_every_module():
+    """The README's module tables list each module of ipfric_core under its layer, and no other."""
+    text = (CORE.parents[1] / 'README.md').read_text()
+    package = CORE / 'ipfric_core'
+    modules = {p.relative_to(package).as_posix() for p in package.rglob('*.py') if p.name != '__init__.py'}
+    for layer in LAYERS:
+        table = text.split(f'`{layer}/`:', 1)[1].split('\n\n', 2)[1]
+        listed = set(re.findall(r'^\| `([a-z_]+\.py)` \|', table, re.M))
+        assert listed == {m.split('/')[1] for m in modules if m.startswith(f'{layer}/')}, layer
+    top = {m for m in modules if '/' not in m}
+    assert all(f'| `{m}` |' in text for m in top), top
