@@ -17,12 +17,12 @@ import sys
 import time
 
 import rclpy
-from ipfric_msgs.msg import VoltageCommand
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
 
+from ipfric_msgs.msg import VoltageCommand
 from ipfric_ros import topics
 
 

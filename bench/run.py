@@ -22,11 +22,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ipfric_core.physics.closedloop import run_closed_loop
 from ipfric_core.analysis.oscillation import classify, crossing_period
-from ipfric_core.design.paperconfig import REPO_ROOT
-from ipfric_core.run.scenario import load_scenario
 from ipfric_core.analysis.sweep import cell_scenario, parse_range, sweep
+from ipfric_core.design.paperconfig import REPO_ROOT
+from ipfric_core.physics.closedloop import run_closed_loop
+from ipfric_core.run.scenario import load_scenario
 
 CONFIG = REPO_ROOT / 'config'
 EMPS = REPO_ROOT.parent / 'shared' / 'data' / 'emps'
@@ -182,7 +182,8 @@ def bench_ros(quick: bool, realtime_s: float, work: Path) -> tuple[list[dict], P
     steps = lock.steps_per_s or 0.0
     rows = [{'benchmark': f'ROS lockstep loop, sim + controller + recorder ({lock.samples} samples)',
              'reference': f'raw rclpy round trip {echo:.0f}/s', 'ipfric': f'{steps:.0f} steps/s',
-             'ratio': steps / echo, 'target': '>= 1000/s and >= 0.8x raw', 'met': steps >= 1000 and steps >= 0.8 * echo}]
+             'ratio': steps / echo, 'target': '>= 1000/s and >= 0.8x raw',
+             'met': steps >= 1000 and steps >= 0.8 * echo}]
     rt = run(cfg, work / 'realtime', realtime_s, sim_params={'time_mode': 'realtime'})
     res = json.loads((work / 'realtime' / 'sim_result.json').read_text())
     lat = res['command_latency_s']

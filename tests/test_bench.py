@@ -5,12 +5,16 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 BENCHMARKS = ('closed loop 2 s, Fig. 7', 'closed loop 2 s vs MuJoCo', 'limit cycle error vs scipy',
               'Figure-11 sweep, 9 runs', 'ROS lockstep loop', 'ROS realtime 1 kHz', 'analyze a',
               'identify on EMPS')
 
 
+@pytest.mark.ros
+@pytest.mark.slow
 def test_quick_bench_runs_every_benchmark(tmp_path):
     results = tmp_path / 'RESULTS.md'
     out = subprocess.run([sys.executable, '-m', 'ipfric_core.cli', 'bench', '--quick', '--json',

@@ -4,6 +4,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -13,14 +15,21 @@ def cli(*args):
     return out
 
 
-def test_design_json_side_by_side():
-    out = cli('design', '--json')
+def test_design_json_side_by_side(data_dir):
+    out = cli('design', '--json', '--data', str(data_dir))
     assert out.returncode == 0, out.stderr
     rep = json.loads(out.stdout)
     for name in ('viscous', 'exponential', 'dynamic'):
         assert rep['gains'][name]['max_rel_diff'] < 3e-5
     assert round(rep['friction_estimates']['mu_s']['ipfric'], 5) == 0.08328
     assert rep['controllability_rank']['dynamic'] == {'rank': 4, 'n_states': 5}
+
+
+def test_design_without_the_data_gives_the_gains_and_says_what_is_left_out(tmp_path):
+    out = cli('design', '--data', str(tmp_path / 'nowhere'))
+    assert out.returncode == 0, out.stderr
+    assert 'exponential model, eq. (23)' in out.stdout and 'Table 6' not in out.stdout
+    assert f'{tmp_path / "nowhere" / "paper"} is absent' in out.stderr
 
 
 def test_stability_json_side_by_side():
@@ -39,6 +48,8 @@ def test_bad_config_is_a_clear_error(tmp_path):
     assert "friction.dynamic.model: 'bristle' is not one of viscous, coulomb, exponential, dynamic" in out.stderr
 
 
+@pytest.mark.ros
+@pytest.mark.slow
 def test_demo_runs_the_default_scenario_and_analyses_it(tmp_path):
     """The README's main job: a closed-loop ROS run of config/default.yaml, then its analysis."""
     out = tmp_path / 'demo'

@@ -8,12 +8,11 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pytest
 from mcap.reader import make_reader
 from mcap.writer import CompressionType
 from mcap_ros2.writer import Writer
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
-
-import pytest
 
 from ipfric_core.analysis.bagread import read_run
 from ipfric_core.cli import main

@@ -43,7 +43,8 @@ def test_cuts_and_byte_flips_are_read_without_crash_or_silent_change(recorded_ba
                        capture_output=True, text=True, timeout=900)
     lines = p.stdout.splitlines()
     last = next((ln for ln in reversed(lines) if ln.startswith('start')), 'no case')
-    assert p.returncode == 0, (f'reader died with {signal.Signals(-p.returncode).name if p.returncode < 0 else p.returncode}'
+    how = signal.Signals(-p.returncode).name if p.returncode < 0 else p.returncode
+    assert p.returncode == 0, (f'reader died with {how}'
                                f' at {last}: {p.stderr[-2000:]}')
     cases = [json.loads(ln) for ln in lines if ln.startswith('{')]
     assert len(cases) == CUTS + FLIPS

@@ -4,9 +4,9 @@ import math
 import numpy as np
 import pytest
 
+from ipfric_core.analysis.oscillation import classify, crossing_period, spectral_period
 from ipfric_core.design import paper
 from ipfric_core.physics.closedloop import run_closed_loop
-from ipfric_core.analysis.oscillation import classify, crossing_period, spectral_period
 from ipfric_core.run.scenario import scenario_from_ros_params
 
 PLANT = {'M': 0.815, 'm': 0.21, 'l': 0.305, 'g': 9.8, 'alpha': 1.7189, 'beta': 7.682}

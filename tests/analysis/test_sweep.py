@@ -5,8 +5,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ipfric_core.run.scenario import load_scenario
 from ipfric_core.analysis.sweep import boundaries, grid, load_cells, parse_range, sweep
+from ipfric_core.run.scenario import load_scenario
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -51,6 +51,7 @@ def test_range_parsing():
 def test_scenario_writes_back_as_the_same_params_file(name, tmp_path):
     """A sweep cell's ROS parameter file loads back to the very scenario it was made from."""
     import yaml
+
     from ipfric_core.analysis.sweep import cell_scenario
     scn = cell_scenario(load_scenario(ROOT / 'config' / name), np.float64(0.015), np.float64(2.5))
     path = tmp_path / 'cell.yaml'
@@ -64,6 +65,7 @@ def test_figure_12_sweep_reproduces_section_5(tmp_path):
     """`./ipfric sweep --figure 12`: effective critical delay near 0.022-0.028 s for 1 < theta0 < 5 deg,
     rising to the linear tau_c (0.107 s) as theta0 -> 0; both panels drawn from one command."""
     import json
+
     from ipfric_core.cli import main
     out = tmp_path / 'fig12'
     assert main(['sweep', '--figure', '12', '--tau', '0.015,0.02,0.025,0.03,0.1,0.105,0.11', '--json',
@@ -77,10 +79,12 @@ def test_figure_12_sweep_reproduces_section_5(tmp_path):
     assert (out / 'figure12.png').stat().st_size > 20_000
 
 
+@pytest.mark.slow
 def test_figure_11_tanh_transitions_coalesce_for_small_angles(tmp_path):
     """Section 5: with tanh(100 v) the two transition delays coalesce for small theta0 and approach
     tau_c = 0.1069 s; with sgn the cart oscillates before the pendulum falls."""
     import json
+
     from ipfric_core.cli import main
     out = tmp_path / 'fig11'
     assert main(['sweep', '--figure', '11', '--tau', '0.01,0.02,0.03,0.04,0.05,0.1,0.105,0.11', '--json',

@@ -1,21 +1,20 @@
 """Identification: loaders, the effect search on data with undeclared effects, EMPS, the
 paper's tables and the closed-loop redesign (no ROS)."""
 import json
-from dataclasses import replace
 
 import numpy as np
 import pytest
+from conftest import ROOT
 
 from ipfric_core.cli import main
-from ipfric_core.ident.records import load_csv, load_emps, write_csv
 from ipfric_core.design.estimation import load_table5, load_table6
-from ipfric_core.ident.excitation import cart_alone_run
 from ipfric_core.ident.equation_error import identify, identify_steady
-from ipfric_core.physics.params import ConfigError, FrictionParams, PlantParams
+from ipfric_core.ident.excitation import cart_alone_run
+from ipfric_core.ident.records import load_csv, load_emps, write_csv
 from ipfric_core.ident.redesign import close_the_loop
+from ipfric_core.physics.params import ConfigError, FrictionParams, PlantParams
 from ipfric_core.physics.rig import PlantTruth
 from ipfric_core.run.scenario import load_scenario
-from conftest import ROOT
 
 PLANT = PlantParams()
 # Table 2: the cart alone with Coulomb and static friction
@@ -93,6 +92,7 @@ def test_clean_data_gets_no_effect_and_the_declared_parameters(clean):
 
 # -- measured data --------------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_emps_beats_the_published_reference_models(data_dir, tmp_path):
     d = data_dir / 'emps'
     assert main(['identify', str(d / 'DATA_EMPS.mat'), '--validation', str(d / 'DATA_EMPS_PULSES.mat'),
@@ -121,6 +121,7 @@ def test_paper_tables_through_the_force_balance(data_dir, paper_cfg):
 
 # -- closing the loop ----------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_redesign_on_identified_stick_slip_shrinks_the_limit_cycle(tmp_path):
     out = close_the_loop(ROOT / 'config' / 'fig7_old_gain_exponential.yaml', tmp_path, 20.0, plots=False)
     assert out['before']['class'] == 'limit_cycle'

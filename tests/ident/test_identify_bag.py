@@ -4,16 +4,18 @@ shrinks the cycle on the same rig."""
 import json
 
 import pytest
-
-from ipfric_core.cli import main
-from ipfric_core.physics.closedloop import run_closed_loop
-from ipfric_core.ident.records import load_bag
-from ipfric_core.analysis.oscillation import classify
-from ipfric_core.run.runner import run
-from ipfric_core.run.scenario import load_scenario
 from rosrun import CONFIG
 
+from ipfric_core.analysis.oscillation import classify
+from ipfric_core.cli import main
+from ipfric_core.ident.records import load_bag
+from ipfric_core.physics.closedloop import run_closed_loop
+from ipfric_core.run.runner import run
+from ipfric_core.run.scenario import load_scenario
 
+
+@pytest.mark.ros
+@pytest.mark.slow
 def test_identify_on_run_bag_and_redesign(tmp_path, capsys):
     rig = CONFIG / 'fig7_old_gain_exponential.yaml'
     res = run(rig, tmp_path / 'run', duration=15.0, timeout=180)

@@ -11,12 +11,12 @@ import json
 import math
 
 import pytest
+from independent import rigsim
 
 from ipfric_core.cli import main
 from ipfric_core.ident.ladder import TYPICAL, run_ladder
 from ipfric_core.ident.model import load_declared
 from ipfric_core.ident.records import load
-from independent import rigsim
 
 CART_S, LOOP_S = 45.0, 20.0
 

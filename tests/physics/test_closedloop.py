@@ -4,10 +4,11 @@ import math
 import numpy as np
 import pytest
 
+from ipfric_core.constants import ANGLE_RESOLUTION_RAD, CART_RESOLUTION_M
 from ipfric_core.design import paper
 from ipfric_core.physics.closedloop import run_closed_loop
 from ipfric_core.physics.controller import StateFeedback, delay_samples
-from ipfric_core.physics.encoder import ANGLE_RESOLUTION_RAD, CART_RESOLUTION_M, quantize
+from ipfric_core.physics.encoder import quantize
 from ipfric_core.physics.plant import CartPendulum
 from ipfric_core.physics.rig import PlantTruth, Rig
 

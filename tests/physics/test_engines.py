@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 
 from ipfric_core.physics.closedloop import run_closed_loop
-from ipfric_core.analysis.oscillation import classify
 from ipfric_core.physics.rig import PlantTruth
 from ipfric_core.run.scenario import load_scenario
 
@@ -19,7 +18,8 @@ from bench.scipy_reference import run_scipy  # noqa: E402
 
 FIELDS = ('t', 'state', 'measured', 'voltage', 'friction', 'stuck')
 EFFECTS = PlantTruth(cogging_N=0.1, cogging_period_m=0.02, deadzone_V=0.1, saturation_V=8.0,
-                     input_delay_s=0.002, asymmetry=0.1, offset_N=0.02, cogging_phase_rad=0.5, backlash_m=1e-4, bias_x_m=1e-3,
+                     input_delay_s=0.002, asymmetry=0.1, offset_N=0.02, cogging_phase_rad=0.5, backlash_m=1e-4,
+                     bias_x_m=1e-3,
                      bias_theta_rad=1e-3)
 
 
@@ -68,6 +68,22 @@ def test_noise_needs_the_python_engine():
     rig.step(0.0)
     with pytest.raises(ValueError, match='already been stepped'):
         run_closed_loop(rig, s.make_controller(), 0.1, engine='compiled')
+
+
+def test_rig_and_controller_hand_over_their_settings_as_frozen_specs():
+    s = replace(scenario('delay_exponential_tau20ms'), truth=EFFECTS)
+    rig, ctl = s.make_rig(), s.make_controller()
+    r, f = rig.loop_spec(), ctl.loop_spec()
+    assert r.drive == (0.1, 8.0, 2.0)                  # input delay 2 ms = 2 samples at 1 kHz
+    assert r.sensors == (1e-3, 1e-3, 1e-4) and r.state[1] == s.sim.theta0 and r.mode == (0.0, 0.0, 0.0)
+    assert f.control[2] == 20.0 and f.control[1] == 0.001 and f.gain == ctl.gain   # tau 20 ms = 20 samples
+    with pytest.raises(AttributeError):
+        r.dt = 0.002
+    assert not ctl.started
+    ctl.update(0.0, 0.01)
+    assert ctl.started
+    with pytest.raises(ValueError, match='controller has already been updated'):
+        run_closed_loop(s.make_rig(), ctl, 0.1, engine='compiled')
 
 
 def test_compiled_engine_matches_the_scipy_reference():

@@ -1,7 +1,7 @@
 import pytest
 
-from ipfric_core.physics.params import ConfigError, FrictionParams, PlantParams
 from ipfric_core.design.paperconfig import load_paper_config
+from ipfric_core.physics.params import ConfigError, FrictionParams, PlantParams
 
 GOOD_PLANT = dict(M=0.815, m=0.21, l=0.305, g=9.8, alpha=1.7189, beta=7.682)
 

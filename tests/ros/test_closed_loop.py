@@ -9,12 +9,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from rosrun import CONFIG, p2p, scenario_file
 
 from ipfric_core.analysis.bagread import read_run
 from ipfric_core.physics.closedloop import run_closed_loop
 from ipfric_core.run.runner import run
 from ipfric_core.run.scenario import load_scenario
-from rosrun import CONFIG, p2p, scenario_file
 
 DURATION = {'fig7_old_gain_exponential': 15.0, 'fig9_new_gain_exponential': 12.0,
             'fig10_new_gain_dynamic': 12.0}
@@ -36,6 +36,7 @@ def runs(tmp_path_factory):
     return get
 
 
+@pytest.mark.slow
 def test_old_gain_on_exponential_plant_keeps_oscillating(runs):
     """Figure 7: gain (15) on the stick-slip plant, a cart limit cycle of order a centimetre."""
     res, bag = runs('fig7_old_gain_exponential')
@@ -49,6 +50,7 @@ def test_old_gain_on_exponential_plant_keeps_oscillating(runs):
     assert np.count_nonzero(np.diff(np.sign(x)) != 0) >= 2
 
 
+@pytest.mark.slow
 def test_new_gains_settle(runs):
     """Figures 9 and 10: gain (23) on the exponential plant and gain (25) on the dynamic plant."""
     old = p2p(*(lambda b: (b.t, b.x))(runs('fig7_old_gain_exponential')[1]))
@@ -125,6 +127,7 @@ def test_bag_is_rosbag2_mcap_with_configuration(runs):
             assert r.deserialize(first[2], conn.msgtype).sample_index == 0
 
 
+@pytest.mark.slow
 def test_realtime_mode_is_paced_by_the_wall_clock(tmp_path):
     cfg = scenario_file(tmp_path, 'fig9_new_gain_exponential.yaml', sim={'time_mode': 'realtime'})
     res = run(cfg, tmp_path / 'run', duration=1.0, timeout=60)
@@ -173,6 +176,7 @@ def test_truncated_bag_is_read_up_to_its_last_complete_record(runs, tmp_path):
     assert a['truncated'] and a['class'] == 'limit_cycle'
 
 
+@pytest.mark.slow
 def test_ros_sweep_gives_the_offline_classes(tmp_path):
     """`./ipfric sweep --ros`: cells through the ROS loop classify exactly as the offline core."""
     from dataclasses import replace

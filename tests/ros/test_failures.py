@@ -6,10 +6,10 @@ import sys
 import time
 
 import pytest
+from rosrun import scenario_file, start_node
 
 from ipfric_core.analysis.bagread import read_run
 from ipfric_core.run.runner import ROOT, Run, pick_domain
-from rosrun import scenario_file, start_node
 
 
 def wait_for_start(log, proc, timeout=60.0):
@@ -57,6 +57,7 @@ def test_run_refuses_a_bad_scenario_before_starting_anything(tmp_path):
     assert not (tmp_path / 'run' / 'logs').exists()
 
 
+@pytest.mark.slow
 def test_killed_controller_trips_the_watchdog_and_fails_the_run(tmp_path):
     # 50 samples x 0.05 s: a SIGKILLed peer stays in the DDS graph until its lease expires,
     # so the simulator waits the full timeout for each sample until the watchdog trips
@@ -85,6 +86,7 @@ def test_killed_controller_trips_the_watchdog_and_fails_the_run(tmp_path):
     assert (bag.truth['voltage_applied'][after] == 0.0).all()
 
 
+@pytest.mark.slow
 def test_ctrl_c_stops_the_run_and_keeps_a_readable_bag(tmp_path):
     out = tmp_path / 'run'
     p = subprocess.Popen([sys.executable, '-m', 'ipfric_core.cli', 'run', '--config',

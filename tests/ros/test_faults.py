@@ -13,10 +13,10 @@ import sys
 import time
 
 import pytest
+from rosrun import Peer, scenario_file
 
 from ipfric_core.analysis.bagread import read_run
 from ipfric_core.run.runner import EXIT_FAULT, ROOT, Run
-from rosrun import Peer, scenario_file
 
 pytestmark = pytest.mark.ros
 CFG = ROOT / 'config' / 'default.yaml'
@@ -129,9 +129,10 @@ def test_a_paused_controller_is_a_stall_event_and_a_fault(tmp_path):
 
 
 def test_a_rogue_flood_is_refused_counted_and_cannot_hold_the_simulator(tmp_path):
+    from rclpy._rclpy_pybind11 import RCLError
+
     from ipfric_msgs.msg import VoltageCommand
     from ipfric_ros import topics
-    from rclpy._rclpy_pybind11 import RCLError
     cfg = scenario_file(tmp_path, 'default.yaml', sim={'duration': 4.0})
     r = Run(cfg, tmp_path / 'run', timeout=300)
     r.start()

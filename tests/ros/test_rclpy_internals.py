@@ -3,10 +3,10 @@ import re
 import time
 
 import pytest
+from rosrun import Peer
 
 from ipfric_ros import rclpy_internals
 from ipfric_ros.rclpy_internals import RCLPY_SERIES, SubscriptionWaiter, check_version, parameter_overrides
-from rosrun import Peer
 
 
 def test_the_installed_rclpy_is_the_checked_series():

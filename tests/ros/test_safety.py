@@ -9,10 +9,10 @@ import json
 import math
 
 import pytest
+from rosrun import Peer, scenario_file, start_node
 
 from ipfric_ros import topics
 from ipfric_sim.safety import BAD_COMMAND, WATCHDOG, CommandGuard, check_command
-from rosrun import Peer, scenario_file, start_node
 
 
 @pytest.mark.parametrize('v, reason', [
@@ -55,9 +55,10 @@ def test_a_burst_of_refusals_gives_two_events_with_counts():
 
 
 def test_sim_refuses_nan_inf_and_out_of_range_commands(tmp_path):
-    from ipfric_msgs.msg import PlantState, SafetyEvent, VoltageCommand
     from sensor_msgs.msg import JointState
     from std_msgs.msg import Float64MultiArray
+
+    from ipfric_msgs.msg import PlantState, SafetyEvent, VoltageCommand
     bad = {10: math.nan, 20: math.inf, 30: 25.0}
     cfg = scenario_file(tmp_path, 'fig7_old_gain_exponential.yaml', sim={'duration': 0.05})
     peer = Peer('fake_controller')
@@ -105,11 +106,12 @@ def test_sim_refuses_nan_inf_and_out_of_range_commands(tmp_path):
 
 def test_controller_skips_nan_measurements_and_validates_parameters(tmp_path):
     from builtin_interfaces.msg import Time
-    from ipfric_msgs.msg import VoltageCommand
     from rcl_interfaces.srv import SetParameters
     from rclpy.parameter import Parameter
     from sensor_msgs.msg import JointState
     from std_msgs.msg import Float64MultiArray
+
+    from ipfric_msgs.msg import VoltageCommand
     cfg = scenario_file(tmp_path, 'fig9_new_gain_exponential.yaml')
     peer = Peer('fake_sim')
     ctl = None

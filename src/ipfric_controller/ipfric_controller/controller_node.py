@@ -20,11 +20,6 @@ from __future__ import annotations
 import math
 import sys
 
-from ipfric_core.physics.closedloop import warm_up
-from ipfric_core.physics.controller import delay_samples
-from ipfric_core.physics.params import ConfigError
-from ipfric_core.run.scenario import Scenario
-from ipfric_msgs.msg import VoltageCommand
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import Clock, ClockType
 from rclpy.duration import Duration
@@ -34,6 +29,11 @@ from rclpy.parameter import Parameter
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 
+from ipfric_core.physics.closedloop import warm_up
+from ipfric_core.physics.controller import delay_samples
+from ipfric_core.physics.params import ConfigError
+from ipfric_core.run.scenario import Scenario
+from ipfric_msgs.msg import VoltageCommand
 from ipfric_ros import topics
 from ipfric_ros.parameters import check_unknown, declare, declare_scenario, finite, plain
 from ipfric_ros.signals import node_process

@@ -1,7 +1,7 @@
 """ipfric_core: the physics, design, analysis and identification of ipfric, without ROS.
 
 Layers, each importing only those before it:
-physics < design < run < analysis < ident; ``cli`` parses the command line and prints.
+constants < physics < design < run < analysis < ident; ``cli`` parses the command line and prints.
 """
 
-__all__ = ['physics', 'design', 'run', 'analysis', 'ident', 'cli']
+__all__ = ['constants', 'physics', 'design', 'run', 'analysis', 'ident', 'cli']

@@ -7,8 +7,8 @@ import math
 import sys
 from pathlib import Path
 
-from .physics.params import ConfigError
 from .design.paperconfig import DEFAULT_CONFIG, DEFAULT_DATA, REPO_ROOT, load_paper_config
+from .physics.params import ConfigError
 
 
 def _print_json(obj) -> None:
@@ -33,7 +33,11 @@ def _eig_text(pairs) -> str:
 def cmd_design(args) -> int:
     cfg = load_paper_config(args.config)      # bad input refused before the long imports
     from .design.reports import design_report
-    rep = design_report(cfg, Path(args.data) / 'paper')
+    tables = Path(args.data) / 'paper'
+    if not tables.is_dir():
+        print(f'[design] {tables} is absent: the friction estimates of the appendix tables are left out (--data)',
+              file=sys.stderr)
+    rep = design_report(cfg, tables if tables.is_dir() else None)
     if args.json:
         _print_json(rep)
         return 0
@@ -48,6 +52,8 @@ def cmd_design(args) -> int:
         print(f'  {label:<34} ipfric {_eig_text(e["ipfric"])}\n  {"":<34} paper  {_eig_text(e["paper"])}')
     print('Controllability rank: ' + ', '.join(f'{k} {v["rank"]}/{v["n_states"]}'
                                                for k, v in rep['controllability_rank'].items()))
+    if 'friction_estimates' not in rep:
+        return 0
     fe = rep['friction_estimates']
     print('Friction from the cart-alone experiments (appendix)')
     print(f'  mu_s (Table 6)                      ipfric {fe["mu_s"]["ipfric"]:.5f} +/- {fe["mu_s"]["std"]:.5f}'
@@ -145,7 +151,7 @@ def cmd_analyze(args) -> int:
     the loss stated); 2: an input refused (not an MCAP file, no bag)."""
     from .analysis.recorded_run import analyze_run, overlay_runs
     results = [analyze_run(p, None if args.no_plots else args.plots) for p in args.runs]
-    out = {'runs': results}
+    out: dict = {'runs': results}
     if len(args.runs) > 1 and not args.no_plots:
         out['overlay'] = overlay_runs(args.runs, Path(args.plots) / 'overlay.png')
     code = 1 if any(r['truncated'] or r['damage'] for r in results) else 0
@@ -176,7 +182,7 @@ def _sweep_base(config, sensors, smoothing, cutoff_hz=None):
 
 
 # The paper's Figures 11-12: scenario, variants (label, smoothing, line style), grids (name, theta0 range [deg])
-FIGURES = {
+FIGURES: dict[str, tuple[str, list[tuple[str, str | None, str]]]] = {
     '11': ('fig9_new_gain_exponential.yaml', [('sgn', 'none', '--'), ('tanh(100v)', 'tanh', '-')]),
     '12': ('fig10_new_gain_dynamic.yaml', [('dynamic', None, '-')]),
 }
@@ -193,7 +199,7 @@ def _figure_sweep(args, taus, progress) -> dict:
     panels, result = [], {'figure_of_paper': args.figure, 'config': str(config), 'variants': {}}
     for gname, trange in FIGURE_GRIDS:
         ths = parse_range(trange)
-        panel = {'title': f'θ0 {ths[0]:g}-{ths[-1]:g} deg', 'taus': taus, 'thetas_deg': ths, 'curves': []}
+        panel: dict = {'title': f'θ0 {ths[0]:g}-{ths[-1]:g} deg', 'taus': taus, 'thetas_deg': ths, 'curves': []}
         for label, smoothing, style in variants:
             base = _sweep_base(config, args.sensors, smoothing, args.cutoff_hz)
             d = out / f'{gname}_{smoothing or "model"}'
@@ -304,7 +310,8 @@ def cmd_sweep(args) -> int:
     summary = {'config': args.config, 'sensors': args.sensors, 'duration_s': args.duration,
                'path': 'ros lockstep' if args.ros else 'offline',
                'cells': len(rows), 'figure': str(fig), 'csv': str(out / 'cells.csv'),
-               'counts': {c: sum(r['class'] == c for r in rows) for c in ('settled', 'limit_cycle', 'growing', 'fallen')},
+               'counts': {c: sum(r['class'] == c for r in rows)
+                          for c in ('settled', 'limit_cycle', 'growing', 'fallen')},
                'boundaries': boundaries(rows, taus, ths)}
     (out / 'summary.json').write_text(json.dumps(summary, indent=2, default=float))
     if args.json:
@@ -320,7 +327,7 @@ def cmd_sweep(args) -> int:
 
 def cmd_identify(args) -> int:
     """Identification on measured data, the paper tables, or the closed-loop redesign."""
-    from .ident.effects import BASE_MODELS, EFFECTS
+    from .ident.effects import EFFECTS
     if args.loop:
         from .ident.redesign import close_the_loop
         out = close_the_loop(args.loop, args.out, args.duration, args.base, not args.no_plots)
@@ -507,12 +514,14 @@ def build_parser() -> argparse.ArgumentParser:
     a.add_argument('--no-plots', action='store_true', help='numbers only')
     w = add('sweep', cmd_sweep, 'stability map over the delay tau and the initial angle theta0 (Figures 11-12), '
             'offline physics core, parallel and resumable')
-    w.add_argument('--config', default=str(REPO_ROOT / 'config' / 'fig9_new_gain_exponential.yaml'), help='base scenario (default %(default)s)')
+    w.add_argument('--config', default=str(REPO_ROOT / 'config' / 'fig9_new_gain_exponential.yaml'),
+                   help='base scenario (default %(default)s)')
     w.add_argument('--tau', default='0:0.14:0.005', help='delays [s], start:stop:step or a,b,c (default %(default)s)')
     w.add_argument('--theta0-deg', default='0:12:0.5', help='initial angles [deg] (default %(default)s)')
     w.add_argument('--duration', type=float, default=20.0, help='simulated seconds per cell (default %(default)s)')
     w.add_argument('--sensors', choices=('exact', 'config'), default='exact',
-                   help='exact states as in the paper\'s simulations, or the scenario\'s encoders (default %(default)s)')
+                   help='exact states as in the paper\'s simulations, or the scenario\'s encoders '
+                   '(default %(default)s)')
     w.add_argument('--smoothing', choices=('none', 'tanh'), default=None, help='override the friction smoothing')
     w.add_argument('--workers', type=int, default=None,
                    help='parallel cells (default: all cores offline, 1 with --ros)')

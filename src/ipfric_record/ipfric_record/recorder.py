@@ -27,13 +27,13 @@ import time
 from pathlib import Path
 
 from ament_index_python.packages import get_package_share_directory
-from ipfric_core.physics.params import ConfigError
-from ipfric_core.run.scenario import load_scenario
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
+from ipfric_core.physics.params import ConfigError
+from ipfric_core.run.scenario import load_scenario
 from ipfric_ros import topics
 from ipfric_ros.parameters import check_unknown, declare
 from ipfric_ros.signals import node_process

@@ -12,12 +12,12 @@ import array
 import difflib
 import math
 
+from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor, ParameterType
+from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException, ParameterException
+from rclpy.parameter import Parameter
+
 from ipfric_core.physics.params import ConfigError
 from ipfric_core.run.scenario import Scenario, nest, scenario_from_ros_params
-from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor, ParameterType
-from rclpy.exceptions import (InvalidParameterTypeException, InvalidParameterValueException,
-                              ParameterException)
-from rclpy.parameter import Parameter
 
 from .rclpy_internals import parameter_overrides
 

@@ -39,7 +39,7 @@ class StopRequest:
         if self.reason is None:
             self.reason = reason
 
-    def install(self) -> 'StopRequest':
+    def install(self) -> StopRequest:
         def handler(signum, _frame):
             self.request(signal.Signals(signum).name)
         for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):

@@ -9,18 +9,21 @@ from __future__ import annotations
 
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-CLOCK = '/clock'
-JOINT_STATES = 'joint_states'
-PLANT_STATE = 'plant_state'
-VOLTAGE_COMMAND = 'voltage_command'
-SAFETY_EVENT = 'safety_event'
-CONTROLLER_GAIN = 'controller_gain'
+# the names are defined once in ipfric_core.constants (the offline analysis reads them too)
+from ipfric_core.constants import (
+    CLOCK,
+    CONTROLLER_GAIN,
+    JOINT_NAMES,
+    JOINT_STATES,
+    PLANT_STATE,
+    SAFETY_EVENT,
+    TERMINAL_EVENTS,
+    VOLTAGE_COMMAND,
+)
 
-#: JointState names of the two encoders, in this order.
-JOINT_NAMES = ('cart', 'pendulum')
-
-#: SafetyEvent codes that end a run.
-TERMINAL_EVENTS = ('END', 'TRACK_LIMIT', 'FALLEN', 'ABORT')
+__all__ = ['CLOCK', 'CONTROLLER_GAIN', 'DATA_DEPTH', 'JOINT_NAMES', 'JOINT_STATES', 'PLANT_STATE', 'RECORD_DEPTH',
+           'SAFETY_EVENT', 'TERMINAL_EVENTS', 'VOLTAGE_COMMAND', 'data_qos', 'latched_qos', 'run_topics',
+           'stamp_of_sample', 'stamp_to_ns']
 
 DATA_DEPTH = 1000
 RECORD_DEPTH = 10000
@@ -40,10 +43,11 @@ def latched_qos(depth: int = 1) -> QoSProfile:
 
 def run_topics() -> dict:
     """Every topic of a run: name -> (message class, ROS type name, latched)."""
-    from ipfric_msgs.msg import PlantState, SafetyEvent, VoltageCommand
     from rosgraph_msgs.msg import Clock
     from sensor_msgs.msg import JointState
     from std_msgs.msg import Float64MultiArray
+
+    from ipfric_msgs.msg import PlantState, SafetyEvent, VoltageCommand
     return {
         CLOCK: (Clock, 'rosgraph_msgs/msg/Clock', False),
         JOINT_STATES: (JointState, 'sensor_msgs/msg/JointState', False),

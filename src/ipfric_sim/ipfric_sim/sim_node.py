@@ -35,11 +35,7 @@ from array import array
 from collections import Counter
 
 import numpy as np
-
 from builtin_interfaces.msg import Time
-from ipfric_core.physics.closedloop import warm_up
-from ipfric_core.physics.params import ConfigError
-from ipfric_msgs.msg import PlantState, SafetyEvent, VoltageCommand
 from rclpy.duration import Duration
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
@@ -47,6 +43,10 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 
+from ipfric_core.constants import ABORT, END, START
+from ipfric_core.physics.closedloop import warm_up
+from ipfric_core.physics.params import ConfigError
+from ipfric_msgs.msg import PlantState, SafetyEvent, VoltageCommand
 from ipfric_ros import topics
 from ipfric_ros.parameters import check_unknown, declare, declare_scenario
 from ipfric_ros.rclpy_internals import SubscriptionWaiter, publisher_gid
@@ -165,7 +165,7 @@ class SimNode(Node):
                         voltage_applied=tr['voltage_applied'], sample_index=k)
         ps.header.stamp = stamp
         self.pub_state.publish(ps)
-        self.published['/clock'] += 1
+        self.published[topics.CLOCK] += 1
         self.published[topics.JOINT_STATES] += 1
         self.published[topics.PLANT_STATE] += 1
 
@@ -176,7 +176,7 @@ class SimNode(Node):
         self.pub_event.publish(msg)
         self.published[topics.SAFETY_EVENT] += 1
         text = f'{code} at sample {k} (t = {k * self.period_ns * 1e-9:.3f} s): {detail}'
-        if code in ('START', 'END'):
+        if code in (START, END):
             self.get_logger().info(text)
         else:  # (rclpy wants one severity per call site)
             self.get_logger().warning(text)
@@ -237,11 +237,11 @@ class SimNode(Node):
     # -- loops -----------------------------------------------------------------------------
     def _end_check(self, limit):
         if self.stop:
-            return 'ABORT', f'stopped by {self.stop.reason}'
+            return ABORT, f'stopped by {self.stop.reason}'
         if limit:
             return limit
         if self.last_sample is not None and self.rig.k >= self.last_sample:
-            return 'END', f'duration {self.settings.duration:g} s reached'
+            return END, f'duration {self.settings.duration:g} s reached'
         return None
 
     def _take_commands(self, timeout: float) -> None:
@@ -347,7 +347,7 @@ class SimNode(Node):
         if not self.wait_for_peers():
             self.get_logger().info(f'stopped by {self.stop.reason} before the start')
             return 0
-        self.event('START', f'{self.settings.time_mode} run of {self.settings.duration:g} s, '
+        self.event(START, f'{self.settings.time_mode} run of {self.settings.duration:g} s, '
                             f'friction {self.scenario.friction.model}, theta0 {self.settings.theta0:g} rad'
                             + (f', gain {self.gain}' if self.gain else ''))
         t0 = self._last_valid = time.monotonic()
@@ -414,14 +414,14 @@ def main(args=None) -> int:
         except StartError as exc:
             logger.fatal(str(exc))
             if node is not None:
-                node.event('ABORT', str(exc))
+                node.event(ABORT, str(exc))
                 node._flush(1.0)
             return 1
         except Exception as exc:  # an internal error still ends the run with a reason
             logger.fatal(f'internal error: {type(exc).__name__}: {exc}')
             if node is not None:
                 try:
-                    node.event('ABORT', f'internal error: {type(exc).__name__}: {exc}')
+                    node.event(ABORT, f'internal error: {type(exc).__name__}: {exc}')
                     node._flush(1.0)
                 except Exception:
                     pass

@@ -1,20 +1,24 @@
 """Recorded runs analysed offline: the MCAP reader, oscillation classes, sweeps, plots.
 
-Modules: bagread, oscillation, plots, recorded_run, sweep. Every public name below is loaded from its module on
-first use, so importing the package stays cheap."""
+Modules: bagread, oscillation, plots, recorded_run, sweep. Every public name below is loaded
+from its module on first use, so importing the package stays cheap."""
 from __future__ import annotations
 
 import importlib
 
 #: public name -> module that defines it
 _WHERE = {
+    'ABSURD': 'bagread',
     'CLASSES': 'oscillation',
     'CLASS_COLOURS': 'plots',
+    'COMPRESSIONS': 'bagread',
     'DECODED': 'bagread',
     'FIELDS': 'sweep',
     'MAGIC': 'bagread',
+    'MAX_CHUNK': 'bagread',
     'Oscillation': 'oscillation',
     'RECORDS': 'bagread',
+    'RESYNC': 'bagread',
     'RunData': 'bagread',
     'SCANNED': 'bagread',
     'SENSORS': 'sweep',
@@ -43,7 +47,6 @@ _WHERE = {
     'run_name': 'recorded_run',
     'spectral_period': 'oscillation',
     'stability_map': 'plots',
-    'sweep': 'sweep',
     'threshold_angle': 'sweep',
     'transition_figure': 'plots',
 }

@@ -42,6 +42,7 @@ from mcap.opcode import Opcode
 from mcap.records import Channel, Footer, Message, Metadata, Schema, Statistics
 from mcap_ros2.decoder import DecoderFactory
 
+from ..constants import CONTROLLER_GAIN, JOINT_STATES, PLANT_STATE, SAFETY_EVENT, VOLTAGE_COMMAND
 from ..physics.compiled import compiled
 from ..physics.params import ConfigError
 
@@ -113,8 +114,8 @@ COMPRESSIONS = ('', 'zstd', 'lz4')
 RESYNC = re.compile(rb'[\x06\x0c\x0f]')        # chunk, metadata, data end: where reading may resume
 MAX_CHUNK = 1 << 30            # largest uncompressed chunk accepted [bytes]
 SKIP, JOINTS, COMMAND, TRUTH, PYTHON = 0, 1, 2, 3, 4
-SCANNED = {'joint_states': JOINTS, 'voltage_command': COMMAND, 'plant_state': TRUTH}
-DECODED = ('safety_event', 'controller_gain')
+SCANNED = {JOINT_STATES: JOINTS, VOLTAGE_COMMAND: COMMAND, PLANT_STATE: TRUTH}
+DECODED = (SAFETY_EVENT, CONTROLLER_GAIN)
 # scanner status
 END, RECORD, FULL, CUT, BAD = 0, 1, 2, 3, 4
 
@@ -291,16 +292,16 @@ class _Reader:
             self.decoders[ch.id] = self.factory.decoder_for(ch.message_encoding, self.schemas.get(ch.schema_id))
         m = self.decoders[ch.id](rec.data)
         topic = ch.topic.lstrip('/')
-        row = None
-        if topic == 'joint_states':
+        row: tuple | None = None
+        if topic == JOINT_STATES:
             row, kind = (_stamp(m.header.stamp), m.position[0], m.position[1]), JOINTS
-        elif topic == 'voltage_command':
+        elif topic == VOLTAGE_COMMAND:
             row, kind = (_stamp(m.measurement_stamp), m.voltage), COMMAND
-        elif topic == 'plant_state':
+        elif topic == PLANT_STATE:
             row, kind = (_stamp(m.header.stamp),) + tuple(float(getattr(m, k)) for k in TRUTH_FIELDS), TRUTH
-        elif topic == 'safety_event':
+        elif topic == SAFETY_EVENT:
             self.events.append((_stamp(m.header.stamp), m.code, m.detail))
-        elif topic == 'controller_gain':
+        elif topic == CONTROLLER_GAIN:
             self.gain = list(m.data)
         if row is not None and topic in self.keep:
             self._grow(kind - 1)

@@ -10,6 +10,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from ..constants import ANGLE_RESOLUTION_RAD, CART_RESOLUTION_M, FALLEN_ANGLE_RAD
+
 CLASSES = ('settled', 'limit_cycle', 'growing', 'fallen')
 
 
@@ -78,7 +80,7 @@ def spectral_period(t: np.ndarray, y: np.ndarray) -> float | None:
     return float(1.0 / f) if f > 0 else None
 
 
-def classify(t, x, theta, resolution=(4.54e-5, 1.534e-3), fallen_angle: float = math.radians(30.0),
+def classify(t, x, theta, resolution=(CART_RESOLUTION_M, ANGLE_RESOLUTION_RAD), fallen_angle: float = FALLEN_ANGLE_RAD,
              ended_fallen: bool = False, window: float = 10.0) -> Oscillation:
     """Classify a run from its samples.
 
@@ -89,8 +91,9 @@ def classify(t, x, theta, resolution=(4.54e-5, 1.534e-3), fallen_angle: float = 
     The larger of the two signals (in counts) then decides: growing if the second half
     of the window has over 1.25 times the peak-to-peak of the first; settled (still
     converging) if it has under half, or if the window holds under 1.5 periods
-    (a creep, not an oscillation); otherwise a limit cycle. Fallen: |theta| reached ``fallen_angle``, or the run ended on a
-    safety limit (``ended_fallen``: the pendulum fell or the cart hit the track end).
+    (a creep, not an oscillation); otherwise a limit cycle. Fallen: |theta| reached
+    ``fallen_angle``, or the run ended on a safety limit (``ended_fallen``: the pendulum
+    fell or the cart hit the track end).
     """
     t, x, theta = (np.asarray(a, float) for a in (t, x, theta))
     over = np.nonzero(np.abs(theta) >= fallen_angle)[0]

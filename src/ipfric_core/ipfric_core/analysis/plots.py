@@ -1,6 +1,7 @@
 """PNG figures of runs and sweeps, in the style of the paper's Figures 7-12."""
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import matplotlib
@@ -8,6 +9,8 @@ import matplotlib
 matplotlib.use('Agg')
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+
+from ..constants import ANGLE_RESOLUTION_RAD  # noqa: E402
 
 CLASS_COLOURS = {'settled': '#2b8cbe', 'limit_cycle': '#fdae61', 'growing': '#f46d43', 'fallen': '#d7191c'}
 
@@ -117,7 +120,7 @@ def resolution_figure(rows, title: str, path: str | Path) -> Path:
     a2.plot(ang, np.degrees([r['true_theta_p2p_rad'] for r in rows]), 'o-', color='C1')
     a2.set(xlabel='angle encoder count (deg)', ylabel='angle p2p (deg)')
     for ax in (a1, a2):
-        ax.axvline(0.08789, color='grey', ls=':', label="the paper's rig")
+        ax.axvline(math.degrees(ANGLE_RESOLUTION_RAD), color='grey', ls=':', label="the paper's rig")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
     fig.suptitle(title)

@@ -1,14 +1,21 @@
 """Offline analysis of recorded runs: class, amplitude, period, sticking, plots."""
 from __future__ import annotations
 
-import math
 import re
 from pathlib import Path
 
 import numpy as np
 
+from ..constants import (
+    ANGLE_RESOLUTION_RAD,
+    CART_RESOLUTION_M,
+    FALLEN_ANGLE_RAD,
+    JOINT_STATES,
+    LIMITS,
+    PLANT_STATE,
+    VOLTAGE_COMMAND,
+)
 from .bagread import RunData, read_run
-from ..physics.encoder import ANGLE_RESOLUTION_RAD, CART_RESOLUTION_M
 from .oscillation import classify
 from .plots import overlay_figure, run_figure
 
@@ -28,11 +35,10 @@ def run_name(path: str | Path) -> str:
 
 def analyze_run(path: str | Path, plot_dir: str | Path | None = None, window: float = 10.0) -> dict:
     """Classify one run from its bag; write its figure to ``plot_dir`` if given."""
-    run = read_run(path, keep=('joint_states',) if plot_dir is None else ('joint_states', 'voltage_command',
-                                                                         'plant_state'))
+    run = read_run(path, keep=(JOINT_STATES,) if plot_dir is None else (JOINT_STATES, VOLTAGE_COMMAND, PLANT_STATE))
     sim = (run.config or {}).get('sim', {})
-    fallen = sim.get('fallen_angle', math.radians(30.0))
-    ended = run.end_reason in ('FALLEN', 'TRACK_LIMIT')
+    fallen = sim.get('fallen_angle', FALLEN_ANGLE_RAD)
+    ended = run.end_reason in LIMITS
     if len(run.t) < 2:
         return {'path': str(path), 'class': None, 'samples': int(len(run.t)), 'truncated': run.truncated,
                 'truncation_detail': run.truncation_detail, 'damage': run.damage, 'error': 'fewer than 2 samples'}

@@ -11,16 +11,17 @@ import csv
 import math
 import os
 import sys
+from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import replace
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
+from ..constants import DURATION, LIMITS
 from ..physics.closedloop import run_closed_loop
-from .oscillation import CLASSES, classify
 from ..run.scenario import Scenario
+from .oscillation import CLASSES, classify
 
 FIELDS = ('tau_s', 'theta0_deg', 'class', 'transition_time_s', 'x_p2p_m', 'theta_p2p_rad', 'period_s')
 
@@ -40,7 +41,7 @@ def classify_samples(scn: Scenario, t, x, theta, fell: bool, window: float = 10.
 def classify_run(scn: Scenario, duration: float, window: float = 10.0):
     """Run ``scn`` offline for ``duration`` [s]; (its Oscillation from the measured positions, the Trajectory)."""
     tr = run_closed_loop(scn.make_rig(), scn.make_controller(), duration)
-    return classify_samples(scn, tr.t, tr.measured[:, 0], tr.measured[:, 1], tr.end_reason != 'duration',
+    return classify_samples(scn, tr.t, tr.measured[:, 0], tr.measured[:, 1], tr.end_reason != DURATION,
                             window), tr
 
 
@@ -67,8 +68,8 @@ def _ros_cell(scn: Scenario, cell_dir: Path, duration: float):
 
     import yaml
 
-    from .bagread import read_run
     from ..run.runner import EXIT_FELL, run
+    from .bagread import read_run
     if cell_dir.exists():          # a cell interrupted before it reached cells.csv: run it again
         shutil.rmtree(cell_dir)
     cell_dir.mkdir(parents=True)
@@ -80,7 +81,7 @@ def _ros_cell(scn: Scenario, cell_dir: Path, duration: float):
     if res.exit_code not in (0, EXIT_FELL):
         raise RuntimeError(f'ROS run of {cell_dir.name} failed:\n{res.summary()}')
     bag = read_run(res.bag)
-    return bag.t, bag.x, bag.theta, bag.end_reason in ('FALLEN', 'TRACK_LIMIT')
+    return bag.t, bag.x, bag.theta, bag.end_reason in LIMITS
 
 
 def _key(tau, theta0_deg) -> tuple:
@@ -89,7 +90,7 @@ def _key(tau, theta0_deg) -> tuple:
 
 def load_cells(path: Path) -> dict:
     """Finished cells of an earlier (possibly interrupted) sweep; a torn last line is ignored."""
-    done = {}
+    done: dict[tuple, dict] = {}
     if not path.exists():
         return done
     with open(path, newline='') as fh:
@@ -97,7 +98,8 @@ def load_cells(path: Path) -> dict:
             try:
                 if row['class'] not in CLASSES:
                     continue
-                typed = {k: (None if row[k] in ('', None) else float(row[k])) for k in FIELDS if k != 'class'}
+                typed: dict[str, object] = {k: (None if row[k] in ('', None) else float(row[k]))
+                                            for k in FIELDS if k != 'class'}
                 typed['class'] = row['class']
                 done[_key(typed['tau_s'], typed['theta0_deg'])] = typed
             except (KeyError, TypeError, ValueError):

@@ -1,7 +1,9 @@
-"""Design on the physics (paper sections 3-5): linearization, LQR, Routh-Hurwitz, the critical delay, friction estimates from the appendix tables, the printed numbers.
+"""Design on the physics (paper sections 3-5): linearization, LQR, Routh-Hurwitz, the critical
+delay, friction estimates from the appendix tables, the printed numbers.
 
-Modules: critical_delay, estimation, linearize, lqr, paper, paperconfig, reports, stability. Every public name below is loaded from its module on
-first use, so importing the package stays cheap."""
+Modules: critical_delay, estimation, linearize, lqr, paper, paperconfig, reports, stability.
+Every public name below is loaded from its module on first use, so importing the package
+stays cheap."""
 from __future__ import annotations
 
 import importlib
@@ -9,6 +11,7 @@ import importlib
 #: public name -> module that defines it
 _WHERE = {
     'BREAKAWAY_MEAN_V': 'paper',
+    'CONTROL_WEIGHT': 'lqr',
     'DEFAULT_CONFIG': 'paperconfig',
     'DEFAULT_DATA': 'paperconfig',
     'DELTA_COMPLEX_UNTIL': 'paper',
@@ -25,15 +28,14 @@ _WHERE = {
     'PaperConfig': 'paperconfig',
     'REDUCED_GAIN_DYNAMIC': 'paper',
     'REPO_ROOT': 'paperconfig',
+    'STATE_WEIGHT': 'lqr',
     'TAU_C_DYNAMIC': 'paper',
     'TAU_C_EXPONENTIAL': 'paper',
-    'WEIGHT': 'paperconfig',
     'characteristic_coefficients': 'linearize',
     'closed_form': 'linearize',
     'controllability_matrix': 'lqr',
     'controllable_basis': 'lqr',
     'coulomb_viscous': 'estimation',
-    'critical_delay': 'critical_delay',
     'delayed_system': 'critical_delay',
     'delta_thresholds': 'stability',
     'design': 'lqr',
@@ -51,7 +53,8 @@ _WHERE = {
     'static_coefficient': 'estimation',
 }
 
-__all__ = sorted(_WHERE) + ['critical_delay', 'estimation', 'linearize', 'lqr', 'paper', 'paperconfig', 'reports', 'stability']
+__all__ = sorted(_WHERE) + ['critical_delay', 'estimation', 'linearize', 'lqr', 'paper', 'paperconfig', 'reports',
+                            'stability']
 
 
 def __getattr__(name: str):

@@ -38,7 +38,7 @@ def critical_delay(A, E, omega_max: float = 200.0, n_grid: int = 20000) -> dict:
         mags = np.abs(_mus(A, E, w)) - 1.0
         if prev is not None and len(mags) == len(prev[1]):
             for k in np.nonzero(np.sign(mags) != np.sign(prev[1]))[0]:
-                wc = brentq(lambda ww: np.abs(_mus(A, E, ww))[k] - 1.0, prev[0], w, xtol=1e-12)
+                wc = brentq(lambda ww, k=k: np.abs(_mus(A, E, ww))[k] - 1.0, prev[0], w, xtol=1e-12)
                 mu = _mus(A, E, wc)[k]
                 tau = np.mod(-np.angle(mu), 2 * np.pi) / wc
                 if best is None or tau < best[0]:

@@ -65,13 +65,13 @@ def coulomb_viscous(plant: PlantParams, volts, vels) -> dict:
         if V[i] != V[j]:
             eps = (plant.alpha * (V[i] - V[j]) - plant.beta * (v[i] - v[j])) / (v[i] - v[j])
             pairs.append(((plant.alpha * V[i] - (plant.beta + eps) * v[i]) / (plant.M * plant.g), eps))
-    pairs = np.array(pairs)
+    table = np.array(pairs)
     return {
         'mu_c': float(coef[0]), 'eps': float(coef[1]),
         'mu_c_std': float(np.sqrt(cov[0, 0])), 'eps_std': float(np.sqrt(cov[1, 1])),
         'residual_rms_N': float(np.sqrt(np.mean(resid ** 2))),
-        'pairwise_mean': {'mu_c': float(pairs[:, 0].mean()), 'eps': float(pairs[:, 1].mean())},
-        'pairwise_spread': {'mu_c': float(pairs[:, 0].std()), 'eps': float(pairs[:, 1].std())},
+        'pairwise_mean': {'mu_c': float(table[:, 0].mean()), 'eps': float(table[:, 1].mean())},
+        'pairwise_spread': {'mu_c': float(table[:, 0].std()), 'eps': float(table[:, 1].std())},
         'n_points': int(len(v)),
     }
 

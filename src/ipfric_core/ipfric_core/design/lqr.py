@@ -8,9 +8,12 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
+from ..physics.params import Field, FrictionParams, PlantParams
 from .linearize import jacobian
-from ..physics.params import FrictionParams, PlantParams
 
+#: bounds of the LQR weights: Q on (x, theta, x', theta') and R on the voltage
+STATE_WEIGHT = Field('', 0.0, 1e12, 'LQR state weight')
+CONTROL_WEIGHT = Field('', 0.0, 1e12, 'LQR control weight', lo_open=True)
 
 def controllability_matrix(A, B) -> np.ndarray:
     """[B, AB, ..., A^(n-1) B]."""
@@ -34,7 +37,7 @@ def controllable_basis(A, B, rtol: float = 1e-9):
     basis: list[np.ndarray] = []
     block = B
     for _ in range(n):
-        new = []
+        new: list[np.ndarray] = []
         for v in block.T:
             scale = np.linalg.norm(v)
             for q in basis + new:

@@ -4,13 +4,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..physics.params import ConfigError, FrictionParams, PlantParams, check_keys, check_number, Field, load_yaml
+from ..physics.params import ConfigError, FrictionParams, PlantParams, check_keys, check_number, load_yaml
+from .lqr import CONTROL_WEIGHT, STATE_WEIGHT
 
 REPO_ROOT = Path(__file__).resolve().parents[4]
 DEFAULT_CONFIG = REPO_ROOT / 'config' / 'paper.yaml'
 DEFAULT_DATA = REPO_ROOT.parent / 'shared' / 'data'
-
-WEIGHT = Field('', 0.0, 1e12, 'LQR weight')
 
 
 @dataclass(frozen=True)
@@ -38,6 +37,6 @@ def load_paper_config(path: str | Path = DEFAULT_CONFIG) -> PaperConfig:
     Q = des['Q']
     if not isinstance(Q, list) or len(Q) != 4:
         raise ConfigError(f'design.Q: expected 4 weights on (x, theta, x\', theta\'), got {Q!r}')
-    Q = tuple(check_number(f'design.Q[{i}]', q, WEIGHT) for i, q in enumerate(Q))
-    R = check_number('design.R', des['R'], Field('', 0.0, 1e12, 'control weight', lo_open=True))
+    Q = tuple(check_number(f'design.Q[{i}]', q, STATE_WEIGHT) for i, q in enumerate(Q))
+    R = check_number('design.R', des['R'], CONTROL_WEIGHT)
     return PaperConfig(plant, friction, Q, R)

@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import brentq
 
-from .linearize import characteristic_coefficients
 from ..physics.params import FrictionParams, PlantParams
+from .linearize import characteristic_coefficients
 
 
 def routh_first_column(coeffs) -> np.ndarray:

@@ -1,6 +1,8 @@
-"""Identification from measured data: records and their loaders, the effect library, fitting, residual analysis, reports, experiments and the redesign loop.
+"""Identification from measured data: records and their loaders, the effect library, fitting,
+residual analysis, reports, experiments and the redesign loop.
 
-Modules: effects, equation_error, excitation, ladder, ladder_report, model, records, redesign, report, residual, shooting. Every public name below is loaded from its module on
+Modules: effects, equation_error, excitation, ladder, ladder_report, model, records,
+redesign, report, residual, shooting. Every public name below is loaded from its module on
 first use, so importing the package stays cheap."""
 from __future__ import annotations
 
@@ -16,7 +18,6 @@ _WHERE = {
     'Balance': 'equation_error',
     'CART_WINDOW_S': 'shooting',
     'DIFF_STEP': 'ladder',
-    'Dithered': 'excitation',
     'EDGE_S': 'equation_error',
     'EFFECTS': 'effects',
     'Effect': 'effects',
@@ -25,6 +26,7 @@ _WHERE = {
     'Fit': 'equation_error',
     'LADDER_EFFECTS': 'model',
     'LAW_PARAMS': 'model',
+    'LEAD_S': 'shooting',
     'MAX_FROZEN': 'records',
     'MAX_LAG': 'residual',
     'MAX_NFEV': 'ladder',
@@ -52,6 +54,7 @@ _WHERE = {
     'SCREEN_GAIN': 'ladder',
     'SIGNATURES': 'residual',
     'SIM_GAIN_PERCENT': 'ladder',
+    'SIZE': 'ladder',
     'STILL_S': 'shooting',
     'STOP_S': 'ladder',
     'STUCK_S': 'equation_error',
@@ -82,7 +85,6 @@ _WHERE = {
     'delayed': 'shooting',
     'design_friction': 'redesign',
     'designed_gain': 'redesign',
-    'dithered_run': 'excitation',
     'dwell_profile': 'effects',
     'effect_starts': 'ladder',
     'effective_input': 'effects',
@@ -93,8 +95,9 @@ _WHERE = {
     'figures': 'report',
     'fit': 'equation_error',
     'fit_model': 'ladder',
+    'fitted_friction_vector': 'effects',
+    'fitted_plant_vector': 'equation_error',
     'friction_summary': 'report',
-    'friction_vector': 'effects',
     'identified': 'ladder_report',
     'identify': 'equation_error',
     'identify_steady': 'equation_error',
@@ -141,6 +144,7 @@ _WHERE = {
     'time_since_reversal': 'residual',
     'total_rms': 'equation_error',
     'trajectory_record': 'records',
+    'unresolved': 'ladder',
     'upright_angle': 'records',
     'whiteness': 'residual',
     'window_sse': 'shooting',
@@ -149,7 +153,8 @@ _WHERE = {
     'write_report': 'report',
 }
 
-__all__ = sorted(_WHERE) + ['effects', 'equation_error', 'excitation', 'ladder', 'ladder_report', 'model', 'records', 'redesign', 'report', 'residual', 'shooting']
+__all__ = sorted(_WHERE) + ['effects', 'equation_error', 'excitation', 'ladder', 'ladder_report', 'model', 'records',
+                            'redesign', 'report', 'residual', 'shooting']
 
 
 def __getattr__(name: str):

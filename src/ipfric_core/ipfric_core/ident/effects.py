@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..physics.friction import DYNAMIC, bristle_path, friction_forces, parameter_vector
+from ..physics.friction import DYNAMIC, bristle_path, friction_forces, friction_vector
 from ..physics.params import FrictionParams
 from ..physics.plant import undeclared_forces
 from ..physics.rig import inputs_through
@@ -142,9 +142,9 @@ def dwell_profile(t: np.ndarray, x: np.ndarray) -> np.ndarray:
     return D
 
 
-def friction_vector(p: dict, active) -> tuple:
+def fitted_friction_vector(p: dict, active) -> tuple:
     """The identified friction as the parameter vector of :mod:`ipfric_core.physics.friction`
-    (:func:`~ipfric_core.physics.friction.parameter_vector` of the law's FrictionParams).
+    (:func:`~ipfric_core.physics.friction.friction_vector` of the law's FrictionParams).
 
     Levels are in N (F_N = 1): mu_c = Fc, mu_s = Fc + Fs_excess, gamma = 2. Without the
     stribeck effect the dynamic law's level stays at Fc. Fc is floored at 1e-9 N, where the
@@ -152,7 +152,7 @@ def friction_vector(p: dict, active) -> tuple:
     """
     asym = {'asymmetry': p['asym'], 'asymmetry_viscous': p['asym_v']} if 'asymmetry' in active else {}
     if 'coulomb' not in active:
-        return parameter_vector(FrictionParams(model='viscous', eps=p['eps'], **asym), 1.0)
+        return friction_vector(FrictionParams(model='viscous', eps=p['eps'], **asym), 1.0)
     fc = max(p['Fc'], 1e-9)
     stribeck = 'stribeck' in active
     if 'presliding' in active:
@@ -161,7 +161,7 @@ def friction_vector(p: dict, active) -> tuple:
     else:
         law = FrictionParams(model='exponential' if stribeck else 'coulomb', eps=p['eps'], mu_c=fc,
                              mu_s=fc + p['Fs_excess'], v_s=p['v_s'] if stribeck else 1.0, **asym)
-    return parameter_vector(law, 1.0)
+    return friction_vector(law, 1.0)
 
 
 def static_level(p: dict, active) -> float:
@@ -186,6 +186,6 @@ def resisting_force(x, v, p: dict, active, dt: float) -> np.ndarray:
     :mod:`ipfric_core.physics.friction`, with the bristle state integrated along v.
     """
     v = np.ascontiguousarray(v, float)
-    fp = friction_vector(p, active)
+    fp = fitted_friction_vector(p, active)
     z = bristle_path(fp, v, dt) if fp[0] == DYNAMIC else np.zeros_like(v)
     return -friction_forces(fp, v, z) + position_force(x, p, active)

@@ -29,10 +29,10 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.signal import butter, sosfiltfilt
 
-from . import effects as fx
-from .records import Record
 from ..physics.params import ConfigError
 from ..physics.plant import held_forces, pendulum_residuals, required_forces
+from . import effects as fx
+from .records import Record
 from .residual import signature_scores, whiteness
 
 MIN_GAIN_PERCENT = 1.0
@@ -152,7 +152,7 @@ def balance(pr: Prepared, p: dict, active) -> Balance:
     if 'backlash' in active:
         g = p['gap']
         x, v, a = x + g * pr.Dx, v + g * pr.Dv, a + g * pr.Da
-    pp = plant_vector(rec, p)
+    pp = fitted_plant_vector(rec, p)
     th = pr.th - p.get('theta_bias', 0.0) if pr.has_theta else np.zeros_like(a)
     thd = pr.thd if pr.has_theta else np.zeros_like(a)
     model = required_forces(pp, a, th, thd) + rec.back_emf * v + fx.resisting_force(x, v, p, active, pr.dt)
@@ -174,7 +174,7 @@ def balance(pr: Prepared, p: dict, active) -> Balance:
     return Balance(y, model, np.where(used, y - model, 0.0), used, pend, x, v, uf, static)
 
 
-def plant_vector(rec: Record, p: dict) -> tuple:
+def fitted_plant_vector(rec: Record, p: dict) -> tuple:
     """The plant vector of :mod:`ipfric_core.physics.plant` with the fitted mass: (M, m, l, g,
     gain, back-EMF), the pendulum's (m, l, g) when attached, else m = 0."""
     m, l, g = rec.pendulum if rec.pendulum is not None else (0.0, 1.0, 9.8)
@@ -365,7 +365,7 @@ def identify(est: Record, val: Record, base_model: str = 'viscous', allowed=None
             break
         ranked.sort(key=lambda z: z[0])
         kept = False
-        for cost, name, f in ranked[:3]:
+        for _, name, f in ranked[:3]:
             ev0, ev1 = total_rms(pv, current), total_rms(pv, f)
             ee0, ee1 = total_rms(pe, current), total_rms(pe, f)
             gain = 100 * (ev0 - ev1) / ev0
@@ -422,7 +422,8 @@ def model_vectors(rec: Record, p: dict, active):
     from .model import ModelVectors
     amp, phase = (math.hypot(p['cog_a'], p['cog_b']), math.atan2(p['cog_b'], p['cog_a'])) if 'cogging' in active \
         else (0.0, 0.0)
-    return ModelVectors(plant_vector(rec, p), fx.friction_vector(p, active),
-                        (amp, p.get('cog_period', 1.0), phase, p.get('F0', 0.0)), p.get('dz', 0.0) * ('deadzone' in active),
-                        p.get('u_max', 0.0) * ('saturation' in active), p.get('gap', 0.0) * ('backlash' in active),
+    return ModelVectors(fitted_plant_vector(rec, p), fx.fitted_friction_vector(p, active),
+                        (amp, p.get('cog_period', 1.0), phase, p.get('F0', 0.0)),
+                        p.get('dz', 0.0) * ('deadzone' in active), p.get('u_max', 0.0) * ('saturation' in active),
+                        p.get('gap', 0.0) * ('backlash' in active),
                         p.get('theta_bias', 0.0), p.get('delay', 0.0) * ('delay' in active))

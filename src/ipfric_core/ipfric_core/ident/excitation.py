@@ -12,11 +12,12 @@ from dataclasses import replace
 
 import numpy as np
 
-from .records import Record, trajectory_record
+from ..constants import DURATION
 from ..physics.closedloop import Trajectory
 from ..physics.params import FrictionParams, PlantParams
 from ..physics.plant import CartPendulum
 from ..physics.rig import PlantTruth, Rig
+from .records import Record, trajectory_record
 
 #: (amplitude [V], frequency [Hz], phase [rad]) of the default multisine
 MULTISINE = ((1.2, 0.4, 0.0), (0.6, 1.1, 1.0), (0.35, 2.7, 2.0), (0.2, 5.3, 0.5))
@@ -41,29 +42,7 @@ def cart_alone_run(plant: PlantParams, friction: FrictionParams, truth: PlantTru
         meas[k] = rig.measure()
         if k < n - 1:
             rig.step(float(volts[k]))
-    traj = Trajectory(t, np.zeros((n, 4)), meas, volts, np.zeros(n), np.zeros(n, bool), 'duration')
+    traj = Trajectory(t, np.zeros((n, 4)), meas, volts, np.zeros(n), np.zeros(n, bool), DURATION)
     return trajectory_record('cart-alone multisine', traj, plant, cart_alone=True)
 
 
-class Dithered:
-    """A state-feedback controller with the multisine (scaled) added to its command.
-
-    Closed-loop identification: the dither keeps the cart moving while the pendulum
-    stays up, so the data show the friction over a range of velocities.
-    """
-
-    def __init__(self, controller, dt: float, scale: float = 0.3):
-        self.controller, self.dt, self.scale, self.k = controller, dt, scale, 0
-
-    def update(self, x: float, theta: float) -> float:
-        v = self.controller.update(x, theta) + float(multisine(np.array(self.k * self.dt), scale=self.scale))
-        self.k += 1
-        return v
-
-
-def dithered_run(scenario, duration: float, scale: float = 0.3) -> Record:
-    """Closed loop of ``scenario`` with a dither on the command; the measured record."""
-    from ..physics.closedloop import run_closed_loop
-    traj = run_closed_loop(scenario.make_rig(), Dithered(scenario.make_controller(), scenario.sample_period, scale),
-                           duration)
-    return trajectory_record('dithered closed loop', traj, scenario.plant)

@@ -198,8 +198,9 @@ def response_lag(rec: Record, max_lag: float = 0.1) -> float:
 def contradictions(pr: Problem, model: Model, name: str) -> list[str]:
     """Why the data refute the fitted effect ``name`` (empty when nothing does)."""
     rec = pr.rec
+    own = {s.name for s in EFFECTS[name].params}
     why = [f'{p.name} = {p.value:.4g} {p.unit} ends on its bound [{p.lo:g}, {p.hi:g}]'
-           for p in model.params if p.free and p.at_bound(1e-3 * TYPICAL.get(p.name, 1.0)) and p.name in {s.name for s in EFFECTS[name].params}]
+           for p in model.params if p.free and p.name in own and p.at_bound(1e-3 * TYPICAL.get(p.name, 1.0))]
     if name == 'deadzone':
         low = smallest_moving_command(rec)
         if low is not None and model['dz'] >= low:
@@ -211,7 +212,8 @@ def contradictions(pr: Problem, model: Model, name: str) -> list[str]:
         above = sorted((u, s) for u, s in steady_speeds(rec) if u > model['u_max'])
         if len(above) >= 2 and above[-1][1] > 1.05 * above[0][1] and above[-1][0] > 1.05 * above[0][0]:
             why.append(f'saturation at {model["u_max"]:.3g} V, but the steady speed still grew from '
-                       f'{above[0][1]:.3g} m/s at {above[0][0]:.3g} V to {above[-1][1]:.3g} m/s at {above[-1][0]:.3g} V')
+                       f'{above[0][1]:.3g} m/s at {above[0][0]:.3g} V to {above[-1][1]:.3g} m/s '
+                       f'at {above[-1][0]:.3g} V')
     if name == 'delay':
         lag = response_lag(rec)
         if model['delay'] > lag + 2 * rec.dt:
@@ -232,9 +234,10 @@ SIZE = {'deadzone': ('dz',), 'delay': ('delay',), 'cogging': ('cog_a', 'cog_b'),
 
 def unresolved(model: Model, std: dict, name: str) -> list[str]:
     """The effect's size is not told from zero: every size parameter within two standard errors."""
-    sizes = [(k, model[k], std.get(k)) for k in SIZE.get(name, ())]
-    if not sizes or any(s is None or not math.isfinite(s) for _, _, s in sizes):
+    stds = [std.get(k) for k in SIZE.get(name, ())]
+    if not stds or any(s is None or not math.isfinite(s) for s in stds):
         return []
+    sizes = [(k, model[k], float(s or 0.0)) for k, s in zip(SIZE[name], stds)]
     if all(abs(v) <= 2 * s for _, v, s in sizes):
         return ['its size is within two standard errors of zero (' +
                 ', '.join(f'{k} = {v:.3g} +/- {s:.2g}' for k, v, s in sizes) + ')']
@@ -257,7 +260,7 @@ def effect_starts(pr: Problem, model: Model, name: str) -> list[dict]:
     if name == 'backlash':
         return [{'gap': g} for g in (3e-4, 1e-3, 3e-3)]
     if name == 'sensor_bias':
-        return [{'theta_bias': float(np.mean(rec.theta))}]
+        return [{'theta_bias': float(np.mean(rec.theta)) if rec.theta is not None else 0.0}]
     return [{}]
 
 
@@ -268,16 +271,14 @@ def candidate(pe: Problem, current: Model, name: str, prior: Model) -> tuple[Mod
     own = {s.name for s in EFFECTS[name].params}
     levels = {p.name for p in current.free} & {'Fc', 'Fs_excess'}
     screen = (own - {'cog_period'}) | levels
-    best = None
-    for s in effect_starts(pe, current, name):
-        m, _ = fit_model(pe, current.with_effect(name, s), max_nfev=12, only=screen, prior=prior)
-        c = pe.cost(m)
-        if best is None or c < best[0]:
-            best = (c, m)
-    if best[0] > (1 - SCREEN_GAIN) * pe.cost(current):
-        return best[1], {}   # explains nothing even with the levels free: not worth a full fit
+    fits = [fit_model(pe, current.with_effect(name, s), max_nfev=12, only=screen, prior=prior)[0]
+            for s in effect_starts(pe, current, name)]
+    costs = [pe.cost(m) for m in fits]
+    best = fits[int(np.argmin(costs))]
+    if min(costs) > (1 - SCREEN_GAIN) * pe.cost(current):
+        return best, {}   # explains nothing even with the levels free: not worth a full fit
     joint = own | ({p.name for p in current.free} & {'Fc', 'Fs_excess', 'eps'})
-    return fit_model(pe, best[1], only=joint, prior=prior)
+    return fit_model(pe, best, only=joint, prior=prior)
 
 
 @dataclass
@@ -321,12 +322,12 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
             ev0, ev1 = pv.cost(current), pv.cost(m)
             ee0, ee1 = pe.cost(current), pe.cost(m)
             gain = 100 * (1 - math.sqrt(ev1 / ev0)) if ev0 > 0 else 0.0
-            p = block_p_value(sse0_v, pv.window_sse(m))
+            pval = block_p_value(sse0_v, pv.window_sse(m))
             why = contradictions(pe, m, name) + unresolved(m, s, name)
             if gain <= SIM_GAIN_PERCENT:
                 why.append(f'validation error drops by {gain:.2f} % (needs > {SIM_GAIN_PERCENT:g} %)')
-            elif p >= P_VALUE:
-                why.append(f'the drop is not significant (p = {p:.2g} over {pv.n_windows} windows)')
+            elif pval >= P_VALUE:
+                why.append(f'the drop is not significant (p = {pval:.2g} over {pv.n_windows} windows)')
             if ee1 >= ee0:
                 why.append('the estimation error does not drop')
             before, after = pv.summary(current), pv.summary(m)
@@ -334,9 +335,9 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
                 if key in before and after[key] > before[key] * (1 + WORSE_PERCENT / 100):
                     why.append(f'validation {key.split("_")[0]} error rises from {before[key]:.3g} to '
                                f'{after[key]:.3g} counts')
-            tried.append({'effect': name, 'validation_gain_percent': gain, 'p_value': p,
+            tried.append({'effect': name, 'validation_gain_percent': gain, 'p_value': pval,
                           'values': {s.name: m[s.name] for s in EFFECTS[name].params}, 'refused': why, 'kept': False})
-            say(f'  tried {name:<11} gain {gain:6.2f} %  p {p:.2g}  ' + ('; '.join(why) or 'passes'))
+            say(f'  tried {name:<11} gain {gain:6.2f} %  p {pval:.2g}  ' + ('; '.join(why) or 'passes'))
             ranked.append((gain, name, m, s, why, len(tried) - 1))
         ok = [r for r in ranked if not r[4]]
         if not ok:

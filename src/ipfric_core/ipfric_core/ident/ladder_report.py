@@ -69,7 +69,8 @@ def ladder_markdown(r: dict) -> str:
     for s in r['ladder']:
         e, v = s['estimation'], s['validation']
         th = f'{v["theta_rms_counts"]:.3g}' if 'theta_rms_counts' in v else '-'
-        lines.append(f'| {s["step"]} | {e["x_rms_counts"]:.3g} | {v["x_rms_counts"]:.3g} | {v["x_percent"]:.3g} | {th} |')
+        lines.append(f'| {s["step"]} | {e["x_rms_counts"]:.3g} | {v["x_rms_counts"]:.3g} | {v["x_percent"]:.3g} '
+                     f'| {th} |')
     lines += ['', f'Effects added: {", ".join(r["effects_added"]) or "none"}.', '']
     for s in r['ladder']:
         lines += [f'### {s["step"]}', '', '| parameter | value | unit | fitted | |', '| --- | --- | --- | --- | --- |']
@@ -77,10 +78,12 @@ def ladder_markdown(r: dict) -> str:
             flag = 'on a bound' if p['at_bound'] else ''
             lines.append(f'| {p["name"]} | {_fmt(p)} | {p["unit"]} | {"yes" if p["fitted"] else "known"} | {flag} |')
         lines += [''] + [f'- {n}' for n in s['notes']] + ([''] if s['notes'] else [])
-    lines += ['## Effects tried', '', '| effect | validation gain % | p | kept | why not |', '| --- | --- | --- | --- | --- |']
+    lines += ['## Effects tried', '', '| effect | validation gain % | p | kept | why not |',
+              '| --- | --- | --- | --- | --- |']
     for t in r['effects_tried']:
         why = '; '.join(t['refused']).replace('|', '/')
-        lines.append(f'| {t["effect"]} | {t["validation_gain_percent"]:.2f} | {t["p_value"]:.2g} | {t["kept"]} | {why} |')
+        lines.append(f'| {t["effect"]} | {t["validation_gain_percent"]:.2f} | {t["p_value"]:.2g} | {t["kept"]} '
+                     f'| {why} |')
     idf = r['identified']
     lines += ['', '## Identified model (scenario sections)', '', '```yaml',
               f'plant: {json.dumps(idf["plant"])}', f'friction: {json.dumps(idf["friction"])}',

@@ -15,9 +15,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-from ..physics.friction import parameter_vector
+from ..physics.friction import friction_vector
 from ..physics.params import ConfigError, FrictionParams, PlantParams
-from ..physics.plant import parameter_vector as plant_vector
+from ..physics.plant import plant_vector
 from ..physics.rig import PlantTruth
 from .effects import EFFECTS
 
@@ -102,18 +102,18 @@ class Model:
     def free(self) -> list[Param]:
         return [p for p in self.params if p.free]
 
-    def with_values(self, values: dict) -> 'Model':
+    def with_values(self, values: dict) -> Model:
         return replace(self, params=tuple(replace(p, value=float(values[p.name])) if p.name in values else p
                                           for p in self.params))
 
-    def with_effect(self, name: str, starts: dict | None = None) -> 'Model':
+    def with_effect(self, name: str, starts: dict | None = None) -> Model:
         """This model with effect ``name`` added (its parameters free, at ``starts`` or defaults)."""
         e = EFFECTS[name]
         new = tuple(Param(s.name, float((starts or {}).get(s.name, s.init or 0.0)), s.unit, s.lo, s.hi, True, e.doc)
                     for s in e.params)
         return replace(self, params=self.params + new, effects=self.effects + (name,))
 
-    def freeing(self, names) -> 'Model':
+    def freeing(self, names) -> Model:
         """Known constants ``names`` fitted too (a refit of a known constant tests the model)."""
         bad = [n for n in names if n not in PLANT_KNOWN]
         if bad:
@@ -151,7 +151,7 @@ class Model:
         if not self.pendulum:
             pp[1] = 0.0
         amp, period, phase = self.cogging()
-        return ModelVectors(tuple(pp), parameter_vector(self.friction_params(), self.normal_force),
+        return ModelVectors(tuple(pp), friction_vector(self.friction_params(), self.normal_force),
                             (amp, period, phase, self.get('F0')), self.get('dz'), self.get('u_max'),
                             self.get('gap'), self.get('theta_bias'), self.get('delay'))
 

@@ -17,10 +17,10 @@ from __future__ import annotations
 import csv
 import gzip
 import io
-import math
 from array import array
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import IO
 
 import numpy as np
 
@@ -78,7 +78,7 @@ class Record:
         """The angle encoder's count [rad]: the smallest step of theta."""
         return smallest_step(self.theta) if self.theta is not None else 1.0
 
-    def split(self, fraction: float) -> tuple['Record', 'Record']:
+    def split(self, fraction: float) -> tuple[Record, Record]:
         """(first ``fraction``, rest) in time: estimation and validation parts."""
         k = int(round(fraction * len(self.t)))
         parts = []
@@ -196,15 +196,13 @@ def _rig_record(name, t, x, u, theta, plant: PlantParams) -> Record:
 def _text_lines(path: Path):
     """The lines of a text file (gzip when it ends in .gz), a byte-order mark dropped."""
     try:
-        raw = path.open('rb')
+        raw: IO[bytes] = path.open('rb')
     except OSError as exc:
         raise ConfigError(f'{path}: cannot read ({exc.strerror})') from exc
-    if path.suffix.lower() == '.gz':
-        raw = gzip.open(raw)
-    stream = io.TextIOWrapper(raw, encoding='utf-8-sig', errors='strict', newline='')
+    data = gzip.GzipFile(fileobj=raw) if path.suffix.lower() == '.gz' else raw
+    stream = io.TextIOWrapper(data, encoding='utf-8-sig', errors='strict', newline='')
     try:
-        for i, line in enumerate(stream, 1):
-            yield i, line
+        yield from enumerate(stream, 1)
     except UnicodeDecodeError as exc:
         raise ConfigError(f'{path}: not a text (UTF-8) CSV file: {exc.reason} near byte {exc.start}') from exc
     except (OSError, EOFError) as exc:

@@ -63,7 +63,7 @@ def export_scenario(path: str | Path, label: str, idf: dict, base: Scenario, rig
     out = {'scenario': str(path), 'friction': friction.to_dict(), 'plant_truth': truth.to_dict(), 'gain': gain}
     if rig is not None:
         on_rig = path.with_name(path.stem + '_on_rig.yaml')
-        on_rig.write_text(f'# The rig of the identified run with the gain designed on the identified model.\n'
+        on_rig.write_text('# The rig of the identified run with the gain designed on the identified model.\n'
                           + yaml.safe_dump(replace(rig, controller=ctrl).to_ros_params(), sort_keys=False))
         load_scenario(on_rig)
         out['on_rig'] = str(on_rig)

@@ -48,8 +48,8 @@ def result_dict(res: dict) -> dict:
                          'validation': errors(pv, base.params, base.active)},
         'error_after': {'estimation': errors(pe, fit.params, fit.active),
                         'validation': errors(pv, fit.params, fit.active)},
-        'simulation_error': shooting.summary(shooting.predict(model_vectors(pv.rec, fit.params, fit.active), pv.rec, win),
-                                             pv.rec, win, 'x'),
+        'simulation_error': shooting.summary(
+            shooting.predict(model_vectors(pv.rec, fit.params, fit.active), pv.rec, win), pv.rec, win, 'x'),
         'residual_white_before': a0['whiteness']['white'],
         'residual_white_after': a1['whiteness']['white'],
         'effects_tried': res['tried'],
@@ -132,7 +132,8 @@ def markdown(r: dict) -> str:
              '| --- | --- | --- | --- | --- |']
     for tag in ('error_before', 'error_after'):
         e = r[tag]
-        lines.append(f'| {tag.split("_")[1]} | {e["estimation"]["rms"]:.4g} | {e["estimation"]["relative_percent"]:.3f} '
+        lines.append(f'| {tag.split("_")[1]} | {e["estimation"]["rms"]:.4g} '
+                     f'| {e["estimation"]["relative_percent"]:.3f} '
                      f'| {e["validation"]["rms"]:.4g} | {e["validation"]["relative_percent"]:.3f} |')
     s = r['simulation_error']
     lines += ['', f'Simulation error on the validation data (multiple shooting, {s["x_windows"]} windows): '

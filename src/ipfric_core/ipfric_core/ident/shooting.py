@@ -112,7 +112,7 @@ def make_windows(rec: Record, length_s: float, forced: bool = False) -> Windows:
     w = (np.array([local_rate(t, th, k) for k in start]) if rec.theta is not None
          else np.zeros(len(start)))
     state = np.column_stack([x[start], th[start], v, w, np.zeros(len(start))])
-    angle = (np.column_stack([rec.theta, rates(t, rec.theta, rec.valid_mask)]) if forced else np.zeros((0, 2)))
+    angle = (np.column_stack([th, rates(t, th, rec.valid_mask)]) if forced else np.zeros((0, 2)))
     return Windows(start, stop, state, held, angle)
 
 
@@ -198,6 +198,7 @@ def reading_errors(pred: Prediction, rec: Record, key: str) -> np.ndarray:
     c = pred.compared
     sim, meas, res = ((pred.x, rec.x, rec.x_resolution) if key == 'x'
                       else (pred.theta, rec.theta, rec.theta_resolution))
+    assert sim is not None and meas is not None, f'no {key} in the record'
     e = (sim[c] - meas[c]) / res
     return np.where(np.isfinite(e), e, 1e4)
 
@@ -207,9 +208,10 @@ def summary(pred: Prediction, rec: Record, win: Windows, key: str) -> dict:
     c = pred.compared
     e = reading_errors(pred, rec, key)
     meas, res = (rec.x, rec.x_resolution) if key == 'x' else (rec.theta, rec.theta_resolution)
+    assert meas is not None, f'no {key} in the record'
     motion = (meas[c] - meas[win.start[pred.window_of[c]]]) / res
     return {f'{key}_windows': len(win), f'{key}_rms_counts': float(np.sqrt(np.mean(e ** 2))),
-            f'{key}_percent': float(100 * np.linalg.norm(e) / max(np.linalg.norm(motion), 1.0))}
+            f'{key}_percent': float(100 * np.linalg.norm(e) / max(float(np.linalg.norm(motion)), 1.0))}
 
 
 def window_sse(pred: Prediction, rec: Record, win: Windows, key: str) -> np.ndarray:

@@ -1,15 +1,17 @@
-"""Physics of the rig (paper sections 2 and 6): parameters, friction laws, the plant, stick-slip integration, encoders and undeclared effects, the sampled controller and closed loop. Knows nothing of ROS, design or data.
+"""Physics of the rig (paper sections 2 and 6): parameters, friction laws, the plant, stick-
+slip integration, encoders and undeclared effects, the sampled controller and closed loop.
+Knows nothing of ROS, design or data.
 
-Modules: closedloop, compiled, controller, encoder, friction, params, plant, rig, simulate. Every public name below is loaded from its module on
-first use, so importing the package stays cheap."""
+Modules: closedloop, compiled, controller, encoder, friction, params, plant, rig, simulate.
+Every public name below is loaded from its module on first use, so importing the package
+stays cheap."""
 from __future__ import annotations
 
 import importlib
 
 #: public name -> module that defines it
 _WHERE = {
-    'ANGLE_RESOLUTION_RAD': 'encoder',
-    'CART_RESOLUTION_M': 'encoder',
+    'CACHE_DIR': 'compiled',
     'CartPendulum': 'plant',
     'ConfigError': 'params',
     'END_REASONS': 'closedloop',
@@ -17,6 +19,7 @@ _WHERE = {
     'FRICTION_FIELDS': 'params',
     'FRICTION_MODELS': 'params',
     'FRICTION_REQUIRED': 'params',
+    'FeedbackSpec': 'controller',
     'Field': 'params',
     'Friction': 'friction',
     'FrictionParams': 'params',
@@ -27,7 +30,9 @@ _WHERE = {
     'PlantParams': 'params',
     'PlantTruth': 'rig',
     'Rig': 'rig',
+    'RigSpec': 'rig',
     'SMOOTHING': 'params',
+    'STALE_AFTER_S': 'compiled',
     'Simulator': 'simulate',
     'StateFeedback': 'controller',
     'Trajectory': 'closedloop',
@@ -37,10 +42,10 @@ _WHERE = {
     'apply_input_effects': 'rig',
     'bristle_path': 'friction',
     'bristle_rate': 'friction',
+    'cache_root': 'compiled',
     'check_choice': 'params',
     'check_keys': 'params',
     'check_number': 'params',
-    'compiled': 'compiled',
     'compiled_unsupported': 'closedloop',
     'delay_samples': 'controller',
     'feedback': 'controller',
@@ -49,23 +54,29 @@ _WHERE = {
     'friction_force': 'friction',
     'friction_forces': 'friction',
     'friction_now': 'simulate',
+    'friction_vector': 'friction',
     'held': 'simulate',
     'held_force': 'plant',
+    'held_forces': 'plant',
     'holding_margin': 'friction',
     'holds': 'friction',
     'input_effects': 'rig',
     'inputs_through': 'rig',
     'load_yaml': 'params',
     'motor_force': 'plant',
-    'parameter_vector': 'friction',
+    'pendulum_residuals': 'plant',
+    'plant_vector': 'plant',
     'play': 'rig',
+    'prune': 'compiled',
     'quantize': 'encoder',
     'rates': 'plant',
+    'required_forces': 'plant',
     'rk4_slide': 'simulate',
     'rk4_stuck': 'simulate',
     'run_closed_loop': 'closedloop',
     'sensor_reading': 'rig',
     'sliding_level': 'friction',
+    'source_key': 'compiled',
     'static_friction': 'friction',
     'static_limit': 'friction',
     'sticks': 'friction',
@@ -73,10 +84,12 @@ _WHERE = {
     'stuck_theta_acceleration': 'plant',
     'undeclared_force': 'plant',
     'undeclared_forces': 'plant',
+    'use_cache': 'compiled',
     'warm_up': 'closedloop',
 }
 
-__all__ = sorted(_WHERE) + ['closedloop', 'compiled', 'controller', 'encoder', 'friction', 'params', 'plant', 'rig', 'simulate']
+__all__ = sorted(_WHERE) + ['closedloop', 'compiled', 'controller', 'encoder', 'friction', 'params', 'plant', 'rig',
+                            'simulate']
 
 
 def __getattr__(name: str):

@@ -17,13 +17,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..constants import DURATION, FALLEN, TRACK_LIMIT
 from .compiled import compiled
-from .controller import StateFeedback, feedback, filter_coefficient, filtered_rate
+from .controller import StateFeedback, feedback, filtered_rate
 from .rig import Rig, input_effects, play, sensor_reading
 from .simulate import advance, friction_now
 
 ENGINES = ('auto', 'python', 'compiled')
-END_REASONS = ('duration', 'FALLEN', 'TRACK_LIMIT')
+#: how an offline run ends, by the compiled engine's code 0, 1, 2
+END_REASONS = (DURATION, FALLEN, TRACK_LIMIT)
 
 
 @dataclass
@@ -45,7 +47,7 @@ def compiled_unsupported(rig: Rig, controller: StateFeedback) -> str | None:
         return f'the controller is a {type(controller).__name__}, not a StateFeedback'
     if rig.k != 0:
         return 'the rig has already been stepped'
-    if controller._last is not None:
+    if controller.started:
         return 'the controller has already been updated'
     if rig.effects.noise_x_m or rig.effects.noise_theta_rad:
         return 'sensor noise (plant_truth.noise_*) is drawn by the python engine only'
@@ -83,7 +85,7 @@ def warm_up(scenario) -> None:
 
 
 def _run_python(rig, controller, n, t, st, meas, volt, fric, stuck):
-    reason = 'duration'
+    reason = DURATION
     k = 0
     for k in range(n):
         mx, mth = rig.measure()
@@ -102,16 +104,9 @@ def _run_python(rig, controller, n, t, st, meas, volt, fric, stuck):
 
 
 def _run_compiled(rig, c, n, t, st, meas, volt, fric, stuck):
-    sim, e = rig.sim, rig.effects
-    sensors = (float(e.bias_x_m), float(e.bias_theta_rad), float(e.backlash_m))
-    drive = (float(e.deadzone_V), float(e.saturation_V), float(len(rig._pending)))
-    control = (filter_coefficient(c.cutoff_hz, c.dt), float(c.dt), float(c._history.maxlen - 1),
-               float(c.voltage_limit))
-    limits = (float(rig.track_limit), float(rig.fallen_angle))
-    res = (float(rig.resolution[0]), float(rig.resolution[1]))
-    return _loop(sim.model.vector, sim.model.friction.vector, sim.extra_force, sim._s, sim._mode,
-                 sim.substep, float(rig.dt), res, sensors, drive, tuple(c.gain), control, limits,
-                 t, st, meas, volt, fric, stuck)
+    r, f = rig.loop_spec(), c.loop_spec()
+    return _loop(r.plant, r.friction, r.extra_force, r.state, r.mode, r.substep, r.dt, r.resolution,
+                 r.sensors, r.drive, f.gain, f.control, r.limits, t, st, meas, volt, fric, stuck)
 
 
 @compiled

@@ -4,18 +4,63 @@ numba checks a cached function against its own file only; a function that calls 
 another module (the closed loop calls the integrator, which calls the friction law) would
 keep a stale copy of the callee after an edit. So every module with compiled code shares
 one cache directory named by a hash of all of them: any edit starts a fresh cache.
+
+The caches live outside the source tree, in :func:`cache_root` (``$IPFRIC_CACHE_DIR``, by
+default ``${XDG_CACHE_HOME:-~/.cache}/ipfric``), as ``numba-<hash>``. Each import marks its
+own cache as used; the caches of other source versions are removed once unused for
+:data:`STALE_AFTER_S` (other checkouts on the machine share the directory and keep theirs).
 """
 from __future__ import annotations
 
 import hashlib
+import os
+import shutil
+import time
 from pathlib import Path
 
 import numba
 
-_HERE = Path(__file__).resolve().parent
-_SOURCES = sorted(p for p in _HERE.parent.rglob('*.py') if '@compiled' in p.read_text())
-_KEY = hashlib.sha256(b''.join(p.read_bytes() for p in _SOURCES)).hexdigest()[:16]
-numba.config.CACHE_DIR = str(_HERE / '__pycache__' / f'numba-{_KEY}')
+#: a cache of another source version that no import has used for this long is removed [s]
+STALE_AFTER_S = 86400.0
+
+
+def cache_root() -> Path:
+    """Directory of the numba caches: ``$IPFRIC_CACHE_DIR``, else ``${XDG_CACHE_HOME:-~/.cache}/ipfric``."""
+    if os.environ.get('IPFRIC_CACHE_DIR'):
+        return Path(os.environ['IPFRIC_CACHE_DIR'])
+    return Path(os.environ.get('XDG_CACHE_HOME') or Path.home() / '.cache') / 'ipfric'
+
+
+def source_key() -> str:
+    """Hash of every ipfric_core module with compiled code (16 hex digits)."""
+    package = Path(__file__).resolve().parent.parent
+    sources = sorted(p for p in package.rglob('*.py') if '@compiled' in p.read_text())
+    return hashlib.sha256(b''.join(p.read_bytes() for p in sources)).hexdigest()[:16]
+
+
+def prune(root: Path, keep: Path, now: float, stale_after: float = STALE_AFTER_S) -> list[Path]:
+    """Remove the ``numba-*`` directories of ``root`` except ``keep`` not used for ``stale_after``
+    [s] before ``now`` [s since the epoch]; returns the removed ones."""
+    removed = []
+    for d in sorted(root.glob('numba-*')):
+        if d != keep and d.is_dir() and now - d.stat().st_mtime > stale_after:
+            shutil.rmtree(d, ignore_errors=True)
+            removed.append(d)
+    return removed
+
+
+def use_cache(root: Path) -> Path:
+    """Point numba at ``root``/numba-<source key>, mark it as used and prune stale siblings."""
+    path = root / f'numba-{source_key()}'
+    path.mkdir(parents=True, exist_ok=True)
+    os.utime(path)
+    prune(root, path, time.time())
+    numba.config.CACHE_DIR = str(path)  # type: ignore[attr-defined]  # numba sets its config at import
+    return path
+
+
+#: the cache directory of this source version
+CACHE_DIR = use_cache(cache_root())
 
 
 def compiled(fn):

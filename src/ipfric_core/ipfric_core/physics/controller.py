@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from dataclasses import dataclass
 
 from .compiled import compiled
-
 
 
 def delay_samples(tau: float, dt: float) -> int:
@@ -45,6 +45,18 @@ def feedback(gain, state, limit: float) -> float:
     return max(-limit, min(limit, v))
 
 
+@dataclass(frozen=True)
+class FeedbackSpec:
+    """A :class:`StateFeedback` as numbers, what the compiled closed loop takes.
+
+    gain : K (x, theta, x', theta') [V/m, V/rad, V s/m, V s/rad]
+    control : (filter pole a, sample period [s], delay [samples], voltage limit [V])
+    """
+
+    gain: tuple
+    control: tuple
+
+
 class StateFeedback:
     """V_k = sat(K . (x, theta, x', theta')_{k-n}) with n = tau / dt.
 
@@ -74,7 +86,7 @@ class StateFeedback:
         self.cutoff_hz = float(cutoff_hz)
         self.voltage_limit = float(voltage_limit)
         self.set_delay(delay)
-        self._last = None
+        self._last: tuple[float, float] | None = None
         self._vel = [0.0, 0.0]
 
     def set_delay(self, tau: float) -> None:
@@ -82,10 +94,22 @@ class StateFeedback:
         n = delay_samples(tau, self.dt)
         self.delay = tau
         old = list(getattr(self, '_history', []))
-        self._history = deque(old[-(n + 1):], maxlen=n + 1)
+        self._depth = n + 1
+        self._history = deque(old[-self._depth:], maxlen=self._depth)
         if old:
-            while len(self._history) < n + 1:
+            while len(self._history) < self._depth:
                 self._history.appendleft(self._history[0])
+
+    @property
+    def started(self) -> bool:
+        """True once a measurement has been pushed (the filter and history hold state)."""
+        return self._last is not None
+
+    def loop_spec(self) -> FeedbackSpec:
+        """The controller's settings as numbers (see :class:`FeedbackSpec`)."""
+        return FeedbackSpec(gain=tuple(self.gain),
+                            control=(filter_coefficient(self.cutoff_hz, self.dt), float(self.dt),
+                                     float(self._depth - 1), float(self.voltage_limit)))
 
     def estimate(self, x: float, theta: float) -> tuple[float, float, float, float]:
         """Push one measurement; return the current state estimate."""
@@ -102,7 +126,7 @@ class StateFeedback:
         """Voltage [V] for the sample whose encoder readings are ``x`` [m], ``theta`` [rad]."""
         est = self.estimate(x, theta)
         if not self._history:
-            self._history.extend([est] * self._history.maxlen)
+            self._history.extend([est] * self._depth)
         else:
             self._history.append(est)
         return feedback(self.gain, self._history[0], self.voltage_limit)

@@ -1,17 +1,13 @@
 """Incremental-encoder measurement: positions rounded to whole counts (paper section 6).
 
-Paper resolutions: angle 0.08789 deg (4096 counts/rev), cart 0.00454 cm.
+The paper rig's resolutions are ``constants.ANGLE_RESOLUTION_RAD`` (0.08789 deg, 4096
+counts/rev) and ``constants.CART_RESOLUTION_M`` (0.00454 cm).
 """
 from __future__ import annotations
-
-import math
 
 import numpy as np
 
 from .compiled import compiled
-
-ANGLE_RESOLUTION_RAD = math.radians(0.08789)
-CART_RESOLUTION_M = 0.00454e-2
 
 
 @compiled

@@ -24,7 +24,7 @@ must cancel stays below mu_s F_N) is a property of the motion, handled by
 :mod:`ipfric_core.physics.simulate` with :func:`holds`.
 
 Each law is written once, as a scalar function of a parameter vector ``fp``
-(:func:`parameter_vector`) compiled by numba: :class:`Friction` calls these functions
+(:func:`friction_vector`) compiled by numba: :class:`Friction` calls these functions
 from Python and the compiled integrator and closed loop call the very same ones.
 """
 from __future__ import annotations
@@ -39,11 +39,12 @@ from .params import FrictionParams
 #: Codes of the friction models in a parameter vector (floats, so the vector is uniform).
 MODEL_CODES = {'viscous': 0.0, 'coulomb': 1.0, 'exponential': 2.0, 'dynamic': 3.0}
 VISCOUS, COULOMB, EXPONENTIAL, DYNAMIC = 0.0, 1.0, 2.0, 3.0
-# Positions in the parameter vector of :func:`parameter_vector`.
-MODEL, SMOOTH, EPS, MU_S, MU_C, V_S, GAMMA, SIGMA0, SIGMA1, DELTA, FN, ASYM, ASYM_V = range(13)
+#: Positions in the parameter vector ``fp`` of :func:`friction_vector`.
+(FP_MODEL, FP_SMOOTH, FP_EPS, FP_MU_S, FP_MU_C, FP_V_S, FP_GAMMA, FP_SIGMA0, FP_SIGMA1, FP_DELTA, FP_FN, FP_ASYM,
+ FP_ASYM_V) = range(13)
 
 
-def parameter_vector(params: FrictionParams, normal_force: float) -> tuple:
+def friction_vector(params: FrictionParams, normal_force: float) -> tuple:
     """The law as a tuple of 13 floats, the argument ``fp`` of the scalar functions below.
 
     (model code, tanh smoothing 0/1, eps, mu_s, mu_c, v_s, gamma, sigma0, sigma1, delta, F_N,
@@ -74,13 +75,13 @@ def static_friction(applied: float, limit: float) -> float:
 @compiled
 def sticks(fp) -> bool:
     """True when the law has a sticking phase: coulomb or exponential without smoothing."""
-    return (fp[MODEL] == COULOMB or fp[MODEL] == EXPONENTIAL) and fp[SMOOTH] == 0.0
+    return (fp[FP_MODEL] == COULOMB or fp[FP_MODEL] == EXPONENTIAL) and fp[FP_SMOOTH] == 0.0
 
 
 @compiled
 def static_limit(fp) -> float:
     """Largest force static friction can hold, mu_s F_N [N] (eq. 5); 0 for viscous."""
-    return 0.0 if fp[MODEL] == VISCOUS else fp[MU_S] * fp[FN]
+    return 0.0 if fp[FP_MODEL] == VISCOUS else fp[FP_MU_S] * fp[FP_FN]
 
 
 @compiled
@@ -88,7 +89,7 @@ def holding_margin(fp, applied: float) -> float:
     """|F_applied - a mu_s F_N| - mu_s F_N [N]: negative while static friction holds (eq. 5 with
     the direction-dependent limits -(1 - a) mu_s F_N and (1 + a) mu_s F_N)."""
     lim = static_limit(fp)
-    return abs(applied - fp[ASYM] * lim) - lim
+    return abs(applied - fp[FP_ASYM] * lim) - lim
 
 
 @compiled
@@ -100,11 +101,11 @@ def holds(fp, applied: float) -> bool:
 @compiled
 def sliding_level(fp, v: float) -> float:
     """Magnitude of the velocity-dependent sliding friction [N]: 0, mu_c F_N or g(v)."""
-    if fp[MODEL] == VISCOUS:
+    if fp[FP_MODEL] == VISCOUS:
         return 0.0
-    if fp[MODEL] == COULOMB:
-        return fp[MU_C] * fp[FN]
-    return stribeck_level(v, fp[MU_S], fp[MU_C], fp[V_S], fp[GAMMA], fp[FN])
+    if fp[FP_MODEL] == COULOMB:
+        return fp[FP_MU_C] * fp[FP_FN]
+    return stribeck_level(v, fp[FP_MU_S], fp[FP_MU_C], fp[FP_V_S], fp[FP_GAMMA], fp[FP_FN])
 
 
 @compiled
@@ -114,27 +115,27 @@ def friction_force(fp, v: float, z: float, direction: float) -> float:
     ``direction`` (+1 or -1) replaces sgn(v) for the sticking laws, so that a step that
     ends exactly at v = 0 keeps the sign of the motion it integrates; 0 = use sgn(v).
     """
-    model = fp[MODEL]
-    viscous = -fp[EPS] * v - fp[ASYM_V] * abs(v)
+    model = fp[FP_MODEL]
+    viscous = -fp[FP_EPS] * v - fp[FP_ASYM_V] * abs(v)
     if model == VISCOUS:
         return viscous
     if model == DYNAMIC:
-        return viscous - fp[SIGMA1] * v - fp[SIGMA0] * z * (1.0 - fp[SIGMA1] * abs(v) / sliding_level(fp, v))
-    if fp[SMOOTH] != 0.0:
-        sign = math.tanh(fp[DELTA] * v)
+        return viscous - fp[FP_SIGMA1] * v - fp[FP_SIGMA0] * z * (1.0 - fp[FP_SIGMA1] * abs(v) / sliding_level(fp, v))
+    if fp[FP_SMOOTH] != 0.0:
+        sign = math.tanh(fp[FP_DELTA] * v)
     elif direction != 0.0:
         sign = direction
     else:
         sign = math.copysign(1.0, v) if v != 0.0 else 0.0
-    return -sliding_level(fp, v) * (sign + fp[ASYM]) + viscous
+    return -sliding_level(fp, v) * (sign + fp[FP_ASYM]) + viscous
 
 
 @compiled
 def bristle_rate(fp, v: float, z: float) -> float:
     """Bristle deflection rate z' [m/s], eq. (10); 0 for the other laws."""
-    if fp[MODEL] != DYNAMIC:
+    if fp[FP_MODEL] != DYNAMIC:
         return 0.0
-    return v - fp[SIGMA0] * abs(v) * z / sliding_level(fp, v)
+    return v - fp[FP_SIGMA0] * abs(v) * z / sliding_level(fp, v)
 
 
 @compiled
@@ -158,7 +159,7 @@ def bristle_path(fp, v, dt: float):
     zk = 0.0
     for k in range(len(v)):
         if v[k] != 0.0:
-            a = fp[SIGMA0] * abs(v[k]) / sliding_level(fp, v[k])
+            a = fp[FP_SIGMA0] * abs(v[k]) / sliding_level(fp, v[k])
             zss = v[k] / a
             zk = zss + (zk - zss) * math.exp(-a * dt)
         z[k] = zk
@@ -183,7 +184,7 @@ class Friction:
         self.model = params.model
         self.smooth = params.smoothing == 'tanh'
         #: The law as the parameter vector of the scalar functions.
-        self.vector = parameter_vector(params, self.normal_force)
+        self.vector = friction_vector(params, self.normal_force)
         #: True when the law has a sticking phase (exact stick-slip).
         self.sticks = sticks(self.vector)
         #: Number of internal friction states (the bristle deflection z).

@@ -8,9 +8,10 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 import yaml
 
@@ -95,7 +96,7 @@ class PlantParams:
     beta: float = 7.682
 
     @classmethod
-    def from_dict(cls, data: Any, path: str = 'plant') -> 'PlantParams':
+    def from_dict(cls, data: Any, path: str = 'plant') -> PlantParams:
         data = check_keys(path, data, set(PLANT_FIELDS), set(PLANT_FIELDS))
         return cls(**{k: check_number(f'{path}.{k}', data[k], s) for k, s in PLANT_FIELDS.items()})
 
@@ -150,7 +151,7 @@ class FrictionParams:
     asymmetry_viscous: float = 0.0
 
     @classmethod
-    def from_dict(cls, data: Any, path: str = 'friction') -> 'FrictionParams':
+    def from_dict(cls, data: Any, path: str = 'friction') -> FrictionParams:
         if not isinstance(data, Mapping):
             raise ConfigError(f'{path}: expected a mapping, got {type(data).__name__}')
         model = check_choice(f'{path}.model', data.get('model'), FRICTION_MODELS)
@@ -175,7 +176,7 @@ class FrictionParams:
         keep |= {k for k in ('asymmetry', 'asymmetry_viscous') if getattr(self, k)}
         return {k: v for k, v in asdict(self).items() if k in keep}
 
-    def replace(self, **changes) -> 'FrictionParams':
+    def replace(self, **changes) -> FrictionParams:
         data = asdict(self)
         data.update(changes)
         return FrictionParams(**data)

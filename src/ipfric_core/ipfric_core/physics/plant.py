@@ -4,7 +4,7 @@ State (SI): s = (x [m], theta [rad from upright], x' [m/s], theta' [rad/s]) and,
 dynamic friction model, z [m] (bristle deflection) as a fifth entry.
 
 The equations are written once, as scalar functions compiled by numba on a plant vector
-``pp`` = (M, m, l, g, alpha, beta) (:func:`parameter_vector`) and the friction vector ``fp``
+``pp`` = (M, m, l, g, alpha, beta) (:func:`plant_vector`) and the friction vector ``fp``
 of :mod:`ipfric_core.physics.friction`; :class:`CartPendulum` and the compiled integrator of
 :mod:`ipfric_core.physics.simulate` both call them.
 """
@@ -14,7 +14,6 @@ import math
 
 import numpy as np
 
-
 from .compiled import compiled
 from .friction import Friction, bristle_rate, friction_force
 from .params import FrictionParams, PlantParams
@@ -23,7 +22,7 @@ from .params import FrictionParams, PlantParams
 M, MP, L, G, ALPHA, BETA = range(6)
 
 
-def parameter_vector(plant: PlantParams) -> tuple:
+def plant_vector(plant: PlantParams) -> tuple:
     """(M [kg], m [kg], l [m], g [m/s^2], alpha [N/V], beta [N s/m]) as floats."""
     return tuple(float(v) for v in (plant.M, plant.m, plant.l, plant.g, plant.alpha, plant.beta))
 
@@ -153,7 +152,7 @@ class CartPendulum:
         self.friction = Friction(friction, fn)
         self.n_states = 4 + self.friction.n_states
         #: The plant as the parameter vector of the scalar functions.
-        self.vector = parameter_vector(plant)
+        self.vector = plant_vector(plant)
 
     def motor_force(self, voltage: float, x_dot: float) -> float:
         """F = alpha V - beta x' [N], eq. (2)."""

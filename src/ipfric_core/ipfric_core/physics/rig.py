@@ -14,7 +14,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-
+from ..constants import FALLEN, FALLEN_ANGLE_RAD, TRACK_LIMIT, TRACK_LIMIT_M
 from .compiled import compiled
 from .encoder import quantize
 from .params import FrictionParams
@@ -115,6 +115,32 @@ def sensor_reading(x, theta, bias_x, bias_theta, noise_x, noise_theta, resolutio
             quantize(theta + bias_theta + noise_theta, resolution[1]))
 
 
+@dataclass(frozen=True)
+class RigSpec:
+    """A :class:`Rig` as numbers, what the compiled closed loop takes (SI units).
+
+    plant, friction, extra_force : the vectors of ``plant.rates``
+    state, mode : the integrator's (x, theta, x', theta', z) and (stuck, direction, events)
+    substep, dt : largest RK4 step and sample period [s]
+    resolution : encoder counts (cart [m], angle [rad])
+    sensors : (bias x [m], bias theta [rad], backlash [m])
+    drive : (deadzone [V], saturation [V], input delay [samples])
+    limits : (track limit [m], fallen angle [rad])
+    """
+
+    plant: tuple
+    friction: tuple
+    extra_force: tuple
+    state: tuple
+    mode: tuple
+    substep: float
+    dt: float
+    resolution: tuple
+    sensors: tuple
+    drive: tuple
+    limits: tuple
+
+
 class Rig:
     """Samples the true plant at period ``dt`` [s] with zero-order-hold voltage.
 
@@ -130,8 +156,8 @@ class Rig:
     """
 
     def __init__(self, model: CartPendulum, truth: PlantTruth, state0, dt: float,
-                 resolution=(0.0, 0.0), track_limit: float = 0.4,
-                 fallen_angle: float = math.radians(30.0)):
+                 resolution=(0.0, 0.0), track_limit: float = TRACK_LIMIT_M,
+                 fallen_angle: float = FALLEN_ANGLE_RAD):
         self.effects = truth
         self.dt = dt
         self.resolution = resolution
@@ -180,13 +206,23 @@ class Rig:
                 'z': s[4] if len(s) == 5 else 0.0, 'stuck': self.sim.stuck,
                 'voltage_applied': self.voltage_applied}
 
+    def loop_spec(self) -> RigSpec:
+        """The rig's settings and current state as numbers (see :class:`RigSpec`)."""
+        e, sim = self.effects, self.sim
+        return RigSpec(plant=sim.model.vector, friction=sim.model.friction.vector, extra_force=sim.extra_force,
+                       state=sim.state_tuple, mode=sim.mode, substep=sim.substep, dt=float(self.dt),
+                       resolution=(float(self.resolution[0]), float(self.resolution[1])),
+                       sensors=(float(e.bias_x_m), float(e.bias_theta_rad), float(e.backlash_m)),
+                       drive=(float(e.deadzone_V), float(e.saturation_V), float(len(self._pending))),
+                       limits=(float(self.track_limit), float(self.fallen_angle)))
+
     def limit_violation(self):
         """None, or (code, detail) when the track or fallen limit is crossed."""
         x, th = self.sim.state[0], self.sim.state[1]
         if not (math.isfinite(x) and math.isfinite(th)):
-            return 'FALLEN', 'state is not finite'
+            return FALLEN, 'state is not finite'
         if abs(th) > self.fallen_angle:
-            return 'FALLEN', f'|theta| = {abs(th):.3f} rad > {self.fallen_angle:.3f} rad'
+            return FALLEN, f'|theta| = {abs(th):.3f} rad > {self.fallen_angle:.3f} rad'
         if abs(x) > self.track_limit:
-            return 'TRACK_LIMIT', f'|x| = {abs(x):.3f} m > {self.track_limit:.3f} m'
+            return TRACK_LIMIT, f'|x| = {abs(x):.3f} m > {self.track_limit:.3f} m'
         return None

@@ -23,11 +23,17 @@ from __future__ import annotations
 
 import math
 
-
 from .compiled import compiled
 from .friction import friction_force, holding_margin, holds, sticks
-from .plant import (NO_EXTRA_FORCE, CartPendulum, held_force, motor_force, rates,
-                    stuck_theta_acceleration, undeclared_force)
+from .plant import (
+    NO_EXTRA_FORCE,
+    CartPendulum,
+    held_force,
+    motor_force,
+    rates,
+    stuck_theta_acceleration,
+    undeclared_force,
+)
 
 MAX_EVENTS = 64  # per substep; a guard, never reached in normal motion
 XTOL = 1e-13     # event time tolerance [s]
@@ -228,6 +234,16 @@ class Simulator:
     def state(self) -> list:
         """(x, theta, x', theta'[, z]) [SI]."""
         return list(self._s[:self.model.n_states])
+
+    @property
+    def state_tuple(self) -> tuple:
+        """The integrator's full state (x, theta, x', theta', z) [SI], z = 0 for laws without it."""
+        return self._s
+
+    @property
+    def mode(self) -> tuple:
+        """The integrator's mode (stuck 0/1, direction of motion of a sticking law, events)."""
+        return self._mode
 
     @property
     def stuck(self) -> bool:

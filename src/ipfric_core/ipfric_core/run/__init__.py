@@ -1,7 +1,7 @@
 """A run scenario (a ROS 2 parameter file) and the supervisor of the node processes.
 
-Modules: runner, scenario. Every public name below is loaded from its module on
-first use, so importing the package stays cheap."""
+Modules: runner, scenario. Every public name below is loaded from its module on first use,
+so importing the package stays cheap."""
 from __future__ import annotations
 
 import importlib
@@ -12,20 +12,26 @@ _WHERE = {
     'CONTROLLER_FIELDS': 'scenario',
     'ControllerSettings': 'scenario',
     'DEFAULT_Q': 'scenario',
+    'DOMAINS': 'runner',
+    'EXIT_FAULT': 'runner',
+    'EXIT_FELL': 'runner',
     'GAIN': 'scenario',
     'GAIN_SOURCES': 'scenario',
     'NODES': 'runner',
+    'PLANT_TRUTH_FIELDS': 'scenario',
+    'PR_SET_PDEATHSIG': 'runner',
+    'RECORDER_PARAMS': 'scenario',
     'ROOT': 'runner',
     'Run': 'runner',
     'RunResult': 'runner',
     'SIM_FIELDS': 'scenario',
+    'SUPERVISED': 'runner',
     'Scenario': 'scenario',
     'SimSettings': 'scenario',
     'TIME_MODES': 'scenario',
-    'TRUTH_FIELDS': 'scenario',
-    'WEIGHT': 'scenario',
     'cmd_run': 'runner',
     'describe_exit': 'runner',
+    'die_with_parent': 'runner',
     'domain_in_use': 'runner',
     'executable': 'runner',
     'last_problem': 'runner',
@@ -37,6 +43,7 @@ _WHERE = {
     'ros_environment': 'runner',
     'run': 'runner',
     'scenario_from_ros_params': 'scenario',
+    'sim_faults': 'runner',
 }
 
 __all__ = sorted(_WHERE) + ['runner', 'scenario']

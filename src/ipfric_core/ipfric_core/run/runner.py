@@ -44,6 +44,7 @@ from pathlib import Path
 
 import yaml
 
+from ..constants import LIMITS
 from ..physics.params import ConfigError, load_yaml
 from .scenario import load_scenario
 
@@ -151,7 +152,7 @@ class RunResult:
     detail: str | None
     out: str
     bag: str
-    domain: int
+    domain: int | None
     samples: int | None = None
     sim_time_s: float | None = None
     wall_time_s: float | None = None
@@ -225,7 +226,7 @@ class Run:
         self.logs: dict[str, Path] = {}
         self.failures: list[str] = []
         self.interrupted = False
-        self._files = []
+        self._files: list = []
 
     # -- start -----------------------------------------------------------------------------
     def prepare(self) -> Path:
@@ -406,7 +407,7 @@ class Run:
             code = EXIT_FAULT
         elif self.interrupted:
             code = 130
-        elif sim.get('end_reason') in ('FALLEN', 'TRACK_LIMIT'):
+        elif sim.get('end_reason') in LIMITS:
             code = EXIT_FELL
         res = RunResult(exit_code=code, end_reason=sim.get('end_reason'), detail=sim.get('detail'),
                         out=str(self.out), bag=str(self.out / 'bag'), domain=self.domain,

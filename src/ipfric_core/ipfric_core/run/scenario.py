@@ -38,14 +38,28 @@ from __future__ import annotations
 
 import difflib
 import math
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
+from ..constants import ANGLE_RESOLUTION_RAD, CART_RESOLUTION_M, FALLEN_ANGLE_RAD, TRACK_LIMIT_M
+from ..design.lqr import CONTROL_WEIGHT, STATE_WEIGHT, design
 from ..physics.controller import StateFeedback, delay_samples
-from ..physics.encoder import ANGLE_RESOLUTION_RAD, CART_RESOLUTION_M
-from ..physics.params import (FRICTION_FIELDS, FRICTION_MODELS, PLANT_FIELDS, SMOOTHING, ConfigError, Field,
-                     FrictionParams, PlantParams, check_keys, check_number, check_choice, load_yaml)
+from ..physics.params import (
+    FRICTION_FIELDS,
+    FRICTION_MODELS,
+    PLANT_FIELDS,
+    SMOOTHING,
+    ConfigError,
+    Field,
+    FrictionParams,
+    PlantParams,
+    check_choice,
+    check_keys,
+    check_number,
+    load_yaml,
+)
 from ..physics.plant import CartPendulum
 from ..physics.rig import PlantTruth, Rig
 
@@ -61,13 +75,13 @@ SIM_FIELDS = {
                                    integer=True)),
     'voltage_max': (10.0, Field('V', 0.0, 1e3, 'largest accepted command', lo_open=True)),
     'theta0': (0.02, Field('rad', -1.0, 1.0, 'initial angle from upright, eq. (30)')),
-    'track_limit': (0.4, Field('m', 0.0, 10.0, 'end the run beyond |x|', lo_open=True)),
-    'fallen_angle': (math.radians(30.0), Field('rad', 0.0, math.pi, 'end the run beyond |theta|',
+    'track_limit': (TRACK_LIMIT_M, Field('m', 0.0, 10.0, 'end the run beyond |x|', lo_open=True)),
+    'fallen_angle': (FALLEN_ANGLE_RAD, Field('rad', 0.0, math.pi, 'end the run beyond |theta|',
                                                lo_open=True)),
     'cart_resolution': (CART_RESOLUTION_M, Field('m', 0.0, 1.0, 'cart encoder count (0 = exact)')),
     'angle_resolution': (ANGLE_RESOLUTION_RAD, Field('rad', 0.0, 1.0, 'angle encoder count (0 = exact)')),
 }
-TRUTH_FIELDS = {
+PLANT_TRUTH_FIELDS = {
     'cogging_N': Field('N', -100.0, 100.0, 'amplitude of the position-periodic force'),
     'cogging_period_m': Field('m', 0.0, 10.0, 'period of the cogging force', lo_open=True),
     'cogging_phase_rad': Field('rad', -10.0, 10.0, 'phase of the cogging force at x = 0'),
@@ -89,10 +103,9 @@ CONTROLLER_FIELDS = {
     'delay': (0.0, Field('s', 0.0, 10.0, 'artificial feedback delay tau, eq. (26), a multiple of the sample period')),
     'cutoff_hz': (20.0, Field('Hz', 0.0, 1e4, 'velocity filter corner (0 = raw difference)')),
     'voltage_limit': (10.0, Field('V', 0.0, 1e3, 'command saturation', lo_open=True)),
-    'R': (1.0, Field('', 0.0, 1e12, 'LQR control weight', lo_open=True)),
+    'R': (1.0, CONTROL_WEIGHT),
 }
 DEFAULT_Q = [5000.0, 3000.0, 20.0, 20.0]
-WEIGHT = Field('', 0.0, 1e12, 'LQR state weight')
 GAIN = Field('V per SI unit', -1e6, 1e6, 'state feedback gain')
 
 
@@ -105,8 +118,8 @@ class SimSettings:
     watchdog_samples: int = 50
     voltage_max: float = 10.0
     theta0: float = 0.02
-    track_limit: float = 0.4
-    fallen_angle: float = math.radians(30.0)
+    track_limit: float = TRACK_LIMIT_M
+    fallen_angle: float = FALLEN_ANGLE_RAD
     cart_resolution: float = CART_RESOLUTION_M
     angle_resolution: float = ANGLE_RESOLUTION_RAD
 
@@ -139,15 +152,17 @@ def parse_sim(data: Mapping, path: str = 'sim_node.ros__parameters'):
     """(SimSettings, PlantParams, FrictionParams, PlantTruth) from a nested mapping."""
     known = set(SIM_FIELDS) | {'time_mode', 'plant', 'friction', 'plant_truth', 'use_sim_time'}
     data = check_keys(path, data, known, {'plant', 'friction'})
-    values = {k: check_number(f'{path}.{k}', data[k], spec) for k, (_, spec) in SIM_FIELDS.items() if k in data}
+    values: dict[str, Any] = {k: check_number(f'{path}.{k}', data[k], spec)
+                              for k, (_, spec) in SIM_FIELDS.items() if k in data}
     if 'watchdog_samples' in values:
         values['watchdog_samples'] = int(values['watchdog_samples'])
     values['time_mode'] = check_choice(f'{path}.time_mode', data.get('time_mode', 'lockstep'), TIME_MODES)
     sim = SimSettings(**values)
     plant = PlantParams.from_dict(data['plant'], f'{path}.plant')
     friction = FrictionParams.from_dict(data['friction'], f'{path}.friction')
-    tdata = check_keys(f'{path}.plant_truth', data.get('plant_truth', {}) or {}, set(TRUTH_FIELDS), set())
-    tvals = {k: check_number(f'{path}.plant_truth.{k}', tdata[k], s) for k, s in TRUTH_FIELDS.items() if k in tdata}
+    tdata = check_keys(f'{path}.plant_truth', data.get('plant_truth', {}) or {}, set(PLANT_TRUTH_FIELDS), set())
+    tvals: dict[str, Any] = {k: check_number(f'{path}.plant_truth.{k}', tdata[k], s)
+                             for k, s in PLANT_TRUTH_FIELDS.items() if k in tdata}
     if 'noise_seed' in tvals:
         tvals['noise_seed'] = int(tvals['noise_seed'])
     truth = PlantTruth(**tvals)
@@ -162,7 +177,7 @@ def parse_sim(data: Mapping, path: str = 'sim_node.ros__parameters'):
 def parse_controller(data: Mapping, path: str = 'controller_node.ros__parameters') -> ControllerSettings:
     known = set(CONTROLLER_FIELDS) | {'gain_source', 'gain', 'plant', 'design_friction', 'Q', 'use_sim_time'}
     data = check_keys(path, data, known, set())
-    values = {k: check_number(f'{path}.{k}', data[k], spec)
+    values: dict[str, Any] = {k: check_number(f'{path}.{k}', data[k], spec)
               for k, (_, spec) in CONTROLLER_FIELDS.items() if k in data}
     source = check_choice(f'{path}.gain_source', data.get('gain_source', 'yaml'), GAIN_SOURCES)
     gain = design_friction = None
@@ -179,7 +194,7 @@ def parse_controller(data: Mapping, path: str = 'controller_node.ros__parameters
     Q = data.get('Q', DEFAULT_Q)
     if not isinstance(Q, (list, tuple)) or len(Q) != 4:
         raise ConfigError(f'{path}.Q: expected 4 weights on (x, theta, x\', theta\'), got {Q!r}')
-    Q = tuple(check_number(f'{path}.Q[{i}]', q, WEIGHT) for i, q in enumerate(Q))
+    Q = tuple(check_number(f'{path}.Q[{i}]', q, STATE_WEIGHT) for i, q in enumerate(Q))
     settings = ControllerSettings(gain_source=source, gain=gain, plant=plant, design_friction=design_friction,
                                   Q=Q, **values)
     try:
@@ -206,7 +221,7 @@ class Scenario:
         c = self.controller
         if c.gain is not None:
             return list(c.gain)
-        from ..design.lqr import design   # python-control: 2 s of imports only a designed gain needs
+        assert c.design_friction is not None  # parse_controller requires it without a gain
         return design(c.plant, c.design_friction, c.Q, c.R).gain[:4].tolist()
 
     def make_rig(self) -> Rig:
@@ -267,7 +282,7 @@ class Scenario:
             plant('plant')
             friction('friction', FrictionParams())
             for f in fields(PlantTruth):
-                num(f'plant_truth.{f.name}', f.default, TRUTH_FIELDS[f.name])
+                num(f'plant_truth.{f.name}', f.default, PLANT_TRUTH_FIELDS[f.name])
         elif node == 'controller_node':
             for k, (default, spec) in CONTROLLER_FIELDS.items():
                 num(k, default, spec)
