@@ -33,6 +33,7 @@ CART_WINDOW_S = 1.0
 PENDULUM_WINDOW_S = 0.25
 STILL_S = 0.02       # an encoder standing still this long before and after a sample: at rest [s]
 FILTER_HZ = 25.0     # corner of the velocity estimate at window starts [Hz]
+REST_SPAN = 3.0      # a window reaches this many times its length to end at a rest
 LEAD_S = 0.1         # no window starts earlier: a delayed command there would come from before the record [s]
 
 
@@ -83,10 +84,11 @@ def still(t: np.ndarray, x: np.ndarray) -> np.ndarray:
     return same_before
 
 
-def make_windows(rec: Record, length_s: float, forced: bool = False) -> Windows:
-    """Windows of about ``length_s`` [s] over the valid stretches of ``rec``, each started where
-    the cart stands still when it can (its state is then known: at rest, held by static
-    friction), else from the measured state with velocities from :func:`local_rate`. With
+def make_windows(rec: Record, length_s: float, forced: bool = False, span: float = REST_SPAN) -> Windows:
+    """Windows of about ``length_s`` [s] over the valid stretches of ``rec``, from one rest of the
+    cart to the next where it can (its state is then known: at rest, held by static friction;
+    a window may reach ``span`` times its length for it), else from the measured state with
+    velocities from :func:`local_rate`. With
     ``forced``, the angle follows the measurement in them (its rate: :func:`rates`)."""
     t, x = rec.t, rec.x
     valid = rec.valid_mask & (t >= t[0] + LEAD_S)
@@ -96,13 +98,13 @@ def make_windows(rec: Record, length_s: float, forced: bool = False) -> Windows:
     edges = np.flatnonzero(np.diff(np.concatenate([[0], valid.astype(int), [0]])))
     for a, b in zip(edges[::2], edges[1::2]):
         k = a
-        while k < b - 1 and t[b - 1] - t[k] >= 0.5 * length_s:
-            end = min(b, int(np.searchsorted(t, t[k] + length_s, side='right')))
-            # the next window starts at a rest within the last half of this one, if any
-            lo = int(np.searchsorted(t, t[k] + 0.5 * length_s))
-            r = np.flatnonzero(rest[lo:end])
-            if len(r) and end < b:
-                end = lo + int(r[-1]) + 1
+        while k < b - 1 and t[b - 1] - t[k] >= 0.3 * length_s:
+            # rest to rest: the window ends at the first rest after 0.3 of its length (up to
+            # span times its length); without one, it ends at its length
+            lo = int(np.searchsorted(t, t[k] + 0.3 * length_s))
+            far = min(b, int(np.searchsorted(t, t[k] + span * length_s, side='right')))
+            r = np.flatnonzero(rest[lo:far])
+            end = lo + int(r[0]) + 1 if len(r) else min(b, int(np.searchsorted(t, t[k] + length_s, side='right')))
             starts.append(k)
             stops.append(end)
             k = end - 1
@@ -123,7 +125,7 @@ def cart_windows(rec: Record) -> Windows:
 
 def angle_windows(rec: Record) -> Windows:
     """The short windows of free coupled motion on which the angle is judged."""
-    return make_windows(rec, PENDULUM_WINDOW_S)
+    return make_windows(rec, PENDULUM_WINDOW_S, span=1.0)
 
 
 @numba.njit(cache=True, parallel=True)   # the windows are independent: one thread each
