@@ -1,6 +1,6 @@
 """A run scenario (a ROS 2 parameter file) and the supervisor of the node processes.
 
-Modules: runner, scenario. Every public name below is loaded from its module on
+Modules: nodes, runner, scenario. Every public name below is loaded from its module on
 first use, so importing the package stays cheap."""
 from __future__ import annotations
 
@@ -8,13 +8,14 @@ import importlib
 
 #: public name -> module that defines it
 _WHERE = {
-    'CONFIG_NAME': 'runner',
+    'CONFIG_NAME': 'nodes',
     'CONTROLLER_FIELDS': 'scenario',
     'ControllerSettings': 'scenario',
     'DEFAULT_Q': 'scenario',
     'GAIN': 'scenario',
     'GAIN_SOURCES': 'scenario',
-    'NODES': 'runner',
+    'NODES': 'nodes',
+    'OVERRIDES': 'nodes',
     'ROOT': 'runner',
     'Run': 'runner',
     'RunResult': 'runner',
@@ -31,15 +32,19 @@ _WHERE = {
     'last_problem': 'runner',
     'load_scenario': 'scenario',
     'nest': 'scenario',
+    'node_parameters': 'nodes',
+    'parse_overrides': 'nodes',
     'parse_controller': 'scenario',
     'parse_sim': 'scenario',
     'pick_domain': 'runner',
+    'ros_args': 'nodes',
     'ros_environment': 'runner',
     'run': 'runner',
     'scenario_from_ros_params': 'scenario',
+    'write_run_scenario': 'nodes',
 }
 
-__all__ = sorted(_WHERE) + ['runner', 'scenario']
+__all__ = sorted(_WHERE) + ['nodes', 'runner', 'scenario']
 
 
 def __getattr__(name: str):

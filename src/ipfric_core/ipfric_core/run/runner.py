@@ -14,7 +14,7 @@ recorder takes every queued message and closes the bag. Ctrl-C does the same. A 
 that dies ends the run with a non-zero exit and a message naming it; the bag recorded up
 to that moment stays readable (as long as the recorder itself is alive).
 
-Output directory ``OUT``: ``bag/`` (metadata.yaml + bag.mcap), ``scenario.yaml`` (the
+Output directory ``OUT``: ``bag/`` (metadata.yaml + bag_0.mcap), ``scenario.yaml`` (the
 parameter file the nodes got, duration applied), ``sim_result.json`` (end reason, samples,
 published counts, speed), ``summary.json`` and ``logs/<node>.log``.
 
@@ -36,18 +36,10 @@ from pathlib import Path
 
 import yaml
 
-from ..physics.params import ConfigError, load_yaml
-from .scenario import load_scenario
+from .nodes import NODES, node_parameters, ros_args, write_run_scenario
 
 ROOT = Path(os.environ.get('IPFRIC_ROOT') or Path(__file__).resolve().parents[4])
 
-#: The processes of a run in start order: name -> (package, executable).
-NODES = {
-    'recorder': ('ipfric_record', 'recorder'),
-    'controller_node': ('ipfric_controller', 'controller_node'),
-    'sim_node': ('ipfric_sim', 'sim_node'),
-}
-CONFIG_NAME = 'scenario.yaml'
 
 
 # ---------------------------------------------------------------------------- environment
@@ -199,21 +191,8 @@ class Run:
     # -- start -----------------------------------------------------------------------------
     def prepare(self) -> Path:
         """Validate the scenario and write OUT/scenario.yaml (raises ConfigError)."""
-        load_scenario(self.config)
-        data = load_yaml(self.config)
-        if self.duration is not None:
-            if not (math.isfinite(self.duration) and self.duration >= 0):
-                raise ConfigError(f'--duration: {self.duration!r} must be >= 0 s')
-            data['sim_node']['ros__parameters']['duration'] = float(self.duration)
-        self.out.mkdir(parents=True, exist_ok=True)
-        if (self.out / 'bag').exists():
-            raise ConfigError(f'{self.out / "bag"} exists already; choose another --out')
-        path = self.out / CONFIG_NAME
-        header = f'# ipfric run of {self.config}' + (
-            f' with duration {self.duration:g} s' if self.duration is not None else '') + '\n'
-        path.write_text(header + yaml.safe_dump(data, sort_keys=False))
-        load_scenario(path)
-        return path
+        return write_run_scenario(self.config, self.out,
+                                  None if self.duration is None else {'duration': float(self.duration)})
 
     def start(self) -> None:
         cfg = self.prepare()
@@ -223,16 +202,9 @@ class Run:
         logdir = self.out / 'logs'
         logdir.mkdir(exist_ok=True)
         env['ROS_LOG_DIR'] = str(logdir / 'ros')
-        sim_params = {'wait_for_recorder': 'true', 'result_file': str(self.out / 'sim_result.json')}
-        sim_params.update({k: str(v).lower() if isinstance(v, bool) else str(v)
-                           for k, v in self.sim_params.items()})
-        args = {
-            'recorder': ['-p', f'output:={self.out / "bag"}', '-p', f'scenario_file:={cfg}'],
-            'controller_node': ['--params-file', str(cfg), '-p', 'min_command_subscribers:=2',
-                                '-p', 'use_sim_time:=true'],
-            'sim_node': ['--params-file', str(cfg)] + [a for k, v in sim_params.items()
-                                                        for a in ('-p', f'{k}:={v}')],
-        }
+        params = node_parameters(cfg, self.out)
+        params['sim_node'][1].update(self.sim_params)
+        args = {name: ros_args(*params[name]) for name in NODES}
         self.t0 = time.monotonic()
         for name in NODES:
             exe = executable(name)
@@ -349,7 +321,7 @@ class Run:
         published = sim.get('published', {})
         match = None
         if published and recorded:
-            match = all(recorded.get(t) == n for t, n in published.items())
+            match = all(recorded.get('/' + t.lstrip('/')) == n for t, n in published.items())
         if match is False:
             self.failures.append('recorded counts differ from the published counts: '
                                  f'published {published}, recorded {recorded}')
