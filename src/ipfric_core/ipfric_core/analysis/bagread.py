@@ -1,6 +1,8 @@
 """Read an ipfric run back from its MCAP file, without a ROS runtime.
 
-Accepts a rosbag2 directory (metadata.yaml + .mcap) or a bare .mcap file. The file is
+Accepts a rosbag2 directory (metadata.yaml + ``bag_0.mcap``, or ``bag.mcap`` of older
+runs) or a bare .mcap file; topics match with or without the leading ``/`` and are
+counted under their fully qualified names. The file is
 streamed chunk by chunk (memory: one chunk plus the arrays kept). The sample-rate topics
 (joint_states, voltage_command, plant_state) are taken from their little-endian CDR by a
 compiled scanner (about 0.1 us a message instead of 15 us through a generic decoder);
@@ -285,7 +287,7 @@ def read_run(path: str | Path, keep=tuple(SCANNED)) -> RunData:
         except (McapError, EOFError, ValueError, KeyError, AssertionError, struct.error) as exc:
             detail = f'{type(exc).__name__}: {exc}'
     truncated = bool(detail)
-    counts = {r.channels[c].topic: int(r.counts[c]) for c in sorted(r.channels) if r.counts[c]}
+    counts = {'/' + r.channels[c].topic.lstrip('/'): int(r.counts[c]) for c in sorted(r.channels) if r.counts[c]}
     j, c, tr = (o[:k] for o, k in zip(r.out, r.n))
     if not len(j) and not truncated:
         raise ConfigError(f'{f}: no joint_states messages; is this an ipfric run?')
