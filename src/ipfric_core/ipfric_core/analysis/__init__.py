@@ -8,24 +8,30 @@ import importlib
 
 #: public name -> module that defines it
 _WHERE = {
+    'ANGLE_ZEROS': 'recorded_run',
     'CLASSES': 'oscillation',
     'CLASS_COLOURS': 'plots',
     'DECODED': 'bagread',
     'FIELDS': 'sweep',
     'MAGIC': 'bagread',
     'Oscillation': 'oscillation',
+    'PERIOD_SPREAD': 'oscillation',
     'RECORDS': 'bagread',
+    'Regime': 'oscillation',
     'RunData': 'bagread',
     'SCANNED': 'bagread',
     'SENSORS': 'sweep',
     'TRUTH_FIELDS': 'bagread',
     'alignment_shift': 'recorded_run',
+    'analyze_log': 'recorded_run',
     'analyze_run': 'recorded_run',
+    'balanced_segments': 'oscillation',
     'boundaries': 'sweep',
     'cell_scenario': 'sweep',
     'classify': 'oscillation',
     'classify_run': 'sweep',
     'classify_samples': 'sweep',
+    'count_size': 'recorded_run',
     'crossing_period': 'oscillation',
     'grid': 'sweep',
     'load_cells': 'sweep',
@@ -35,6 +41,7 @@ _WHERE = {
     'parse_range': 'sweep',
     'print_progress': 'sweep',
     'read_run': 'bagread',
+    'regimes': 'oscillation',
     'resolution_cell': 'sweep',
     'resolution_figure': 'plots',
     'resolution_study': 'sweep',
@@ -46,6 +53,7 @@ _WHERE = {
     'sweep': 'sweep',
     'threshold_angle': 'sweep',
     'transition_figure': 'plots',
+    'upright_angle': 'recorded_run',
 }
 
 __all__ = sorted(_WHERE) + ['bagread', 'oscillation', 'plots', 'recorded_run', 'sweep']

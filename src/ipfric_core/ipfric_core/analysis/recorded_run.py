@@ -1,4 +1,9 @@
-"""Offline analysis of recorded runs: class, amplitude, period, sticking, plots."""
+"""Offline analysis of recorded runs and rig logs: class, amplitude, period, sticking, plots.
+
+A run's bag (:func:`analyze_run`) is judged by its final regime; a rig's log (CSV or
+MATLAB, :func:`analyze_log`) is cut into the stretches where the pendulum is balanced
+and each into regimes (:func:`ipfric_core.analysis.oscillation.regimes`).
+"""
 from __future__ import annotations
 
 import math
@@ -9,8 +14,11 @@ import numpy as np
 
 from .bagread import RunData, read_run
 from ..physics.encoder import ANGLE_RESOLUTION_RAD, CART_RESOLUTION_M
-from .oscillation import classify
+from ..physics.params import ConfigError
+from .oscillation import balanced_segments, classify, regimes
 from .plots import overlay_figure, run_figure
+
+ANGLE_ZEROS = ('auto', 'upright', 'hanging')
 
 
 def _resolution(run: RunData) -> tuple[float, float]:
@@ -88,3 +96,55 @@ def overlay_runs(paths, plot_path: str | Path) -> dict:
     fig = overlay_figure([(r.t, r.x) for r in runs], [Path(p).name for p in paths], shifts, plot_path)
     return {'figure': str(fig), 'shifts': [{'path': str(p), 'time_s': s[0], 'position_m': s[1]}
                                            for p, s in zip(paths, shifts)]}
+
+
+def upright_angle(theta, zero: str = 'auto') -> tuple[np.ndarray, str]:
+    """The angle from upright in (-pi, pi] [rad], and the zero it was measured from.
+
+    ``zero``: 'upright', 'hanging' (upright is +-pi), or 'auto': hanging when the median
+    of |theta| wrapped to (-pi, pi] exceeds pi/2 (the pendulum mostly far from upright).
+    """
+    if zero not in ANGLE_ZEROS:
+        raise ConfigError(f'angle zero {zero!r}: allowed {", ".join(ANGLE_ZEROS)}')
+    theta = np.asarray(theta, float)
+    if zero == 'auto':
+        zero = 'hanging' if np.median(np.abs(np.angle(np.exp(1j * theta)))) > math.pi / 2 else 'upright'
+    shifted = theta - math.pi if zero == 'hanging' else theta
+    return np.angle(np.exp(1j * shifted)), zero
+
+
+def count_size(y) -> float:
+    """The smallest step of a sampled signal: its encoder count when it is quantized."""
+    d = np.abs(np.diff(np.asarray(y, float)))
+    d = d[d > 0]
+    return float(d.min()) if len(d) else 0.0
+
+
+def analyze_log(path: str | Path, columns: dict | None = None, angle_zero: str = 'auto',
+                max_angle: float = math.radians(20.0), min_duration: float = 2.0,
+                plot_dir: str | Path | None = None) -> dict:
+    """A rig's log (the formats of ``identify``: CSV t, x, voltage, theta; ``columns``
+    maps names to headers) cut into balanced stretches (|theta| < ``max_angle`` [rad] for
+    at least ``min_duration`` [s]), each into regimes: class, time span, cart and angle
+    peak-to-peak, period by zero crossings and by spectrum, sticking."""
+    from ..ident.records import load
+    rec = load(path, None, columns)
+    if rec.theta is None:
+        raise ConfigError(f'{path}: no pendulum angle in the file; analyze needs t, x and theta '
+                          f'(map a CSV column with --columns theta=NAME)')
+    theta, zero = upright_angle(rec.theta, angle_zero)
+    resolution = (count_size(rec.x), count_size(theta))
+    segments = []
+    for a, b in balanced_segments(rec.t, theta, max_angle, min_duration):
+        parts = regimes(rec.t[a:b], rec.x[a:b], theta[a:b], resolution)
+        segments.append({'start': float(rec.t[a]), 'end': float(rec.t[b - 1]), 'class': parts[-1].cls,
+                         'regimes': [r.to_dict() for r in parts]})
+    out = {'path': str(path), 'samples': int(len(rec.t)), 'duration_s': float(rec.t[-1] - rec.t[0]),
+           'sample_period_s': rec.dt, 'angle_zero': zero, 'count_size': list(resolution), 'segments': segments}
+    if plot_dir is not None:
+        d = Path(plot_dir)
+        d.mkdir(parents=True, exist_ok=True)
+        spans = [(r['start'], r['end'], r['cls']) for s in segments for r in s['regimes']]
+        out['figure'] = str(run_figure(rec.t, rec.x, theta, rec.t, rec.u, f'{Path(path).name}: {len(segments)} '
+                                       f'balanced stretch(es)', d / f'{Path(path).stem}.png', spans=spans))
+    return out
