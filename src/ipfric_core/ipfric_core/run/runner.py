@@ -41,7 +41,6 @@ from .nodes import NODES, node_parameters, ros_args, write_run_scenario
 ROOT = Path(os.environ.get('IPFRIC_ROOT') or Path(__file__).resolve().parents[4])
 
 
-
 # ---------------------------------------------------------------------------- environment
 def ros_environment(domain: int) -> dict:
     """The environment of scripts/env.sh plus the run's domain, DDS on loopback only."""
