@@ -1,5 +1,7 @@
 """Bags of both layouts read alike: rosbag2's (``bag_0.mcap``, ``/joint_states``) and the
 older one of this project (``bag.mcap``, ``joint_states``)."""
+import json
+
 import numpy as np
 import pytest
 from mcap_ros2.writer import Writer
@@ -46,3 +48,16 @@ def test_both_layouts_give_the_same_run(tmp_path, file_name, prefix):
         np.testing.assert_array_equal(r.theta, -2e-4 * k)
         assert r.events == [(0.199, 'END', 'duration')] and r.end_reason == 'END'
         assert r.counts == {'/joint_states': 200, '/safety_event': 1}
+
+
+def test_analysis_reports_the_loop_timing_of_a_run(tmp_path):
+    """Stale samples (no fresh command at the deadline) and latency from sim_result.json."""
+    from ipfric_core.analysis.recorded_run import analyze_run
+    write_run(tmp_path / 'run', 'bag_0.mcap', '/')
+    assert 'samples_without_command' not in analyze_run(tmp_path / 'run')
+    latency = {'commands': 199, 'median': 3e-4, 'p99': 1.4e-3, 'max': 0.037}
+    (tmp_path / 'run' / 'sim_result.json').write_text(json.dumps(
+        {'time_mode': 'realtime', 'samples_without_command': 3, 'command_latency_s': latency}))
+    for path in (tmp_path / 'run', tmp_path / 'run' / 'bag', tmp_path / 'run' / 'bag' / 'bag_0.mcap'):
+        a = analyze_run(path)
+        assert (a['time_mode'], a['samples_without_command'], a['command_latency_s']) == ('realtime', 3, latency)

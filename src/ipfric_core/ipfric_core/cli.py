@@ -133,6 +133,12 @@ def _print_analysis(r: dict) -> None:
         print(f'  period: {pc and round(pc, 3)} s (zero crossings), {ps and round(ps, 3)} s (spectrum)'
               + ('' if r['periods_agree'] else ': estimates disagree, an irregular oscillation')
               + (f'; {r["frequency"]:.3f} Hz' if r['frequency'] else ''))
+    if r.get('samples_without_command') is not None:
+        lat = r.get('command_latency_s') or {}
+        print(f'  {r["time_mode"]}: {r["samples_without_command"]} samples without a fresh command '
+              f'({100 * r["samples_without_command"] / r["samples"]:.2f} %)'
+              + (f'; command latency median {lat["median"] * 1e3:.3f} ms, p99 {lat["p99"] * 1e3:.3f} ms, '
+                 f'max {lat["max"] * 1e3:.3f} ms' if lat.get('median') is not None else ''))
     if 'figure' in r:
         print(f'  figure: {r["figure"]}')
 

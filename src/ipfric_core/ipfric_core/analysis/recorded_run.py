@@ -6,6 +6,7 @@ and each into regimes (:func:`ipfric_core.analysis.oscillation.regimes`).
 """
 from __future__ import annotations
 
+import json
 import math
 import re
 from pathlib import Path
@@ -49,7 +50,7 @@ def analyze_run(path: str | Path, plot_dir: str | Path | None = None, window: fl
     out = {'path': str(path), 'samples': int(len(run.t)), 'duration_s': float(run.t[-1] - run.t[0]),
            'end_reason': run.end_reason, 'truncated': run.truncated,
            'truncation_detail': run.truncation_detail, 'counts': run.counts, 'gain': run.gain,
-           **{('class' if k == 'cls' else k): v for k, v in o.to_dict().items()}}
+           **{('class' if k == 'cls' else k): v for k, v in o.to_dict().items()}, **loop_timing(path)}
     if plot_dir is not None:
         d = Path(plot_dir)
         d.mkdir(parents=True, exist_ok=True)
@@ -61,6 +62,23 @@ def analyze_run(path: str | Path, plot_dir: str | Path | None = None, window: fl
         out['figure'] = str(run_figure(run.t, run.x, run.theta, run.command_t, run.voltage, title,
                                        d / f'{name}.png', phase))
     return out
+
+
+def loop_timing(path: str | Path) -> dict:
+    """What sim_node measured of the loop (``sim_result.json`` of a run directory, beside
+    or above the bag): time mode, samples at which no fresh command had arrived (the held
+    command was applied: an extra sample of delay the plant saw) and the command latency
+    [s]; empty for a bag without it."""
+    p = Path(path)
+    for d in (p, p.parent, p.parent.parent):
+        f = d / 'sim_result.json'
+        if f.is_file():
+            try:
+                sim = json.loads(f.read_text())
+            except ValueError:
+                return {}
+            return {k: sim.get(k) for k in ('time_mode', 'samples_without_command', 'command_latency_s')}
+    return {}
 
 
 def alignment_shift(t_ref, x_ref, t, x) -> tuple[float, float]:
