@@ -81,7 +81,7 @@ def test_scanner_reads_what_was_written(tmp_path):
     np.testing.assert_array_equal(r.truth['voltage_applied'], -k.astype(float))
     assert r.events == [(0.5, 'END', 'done')] and r.end_reason == 'END'
     assert r.config == {'sim': {'theta0': 0.02}} and not r.truncated
-    assert r.counts == {'joint_states': n, 'voltage_command': n, 'plant_state': n, 'safety_event': 1}
+    assert r.counts == {'/joint_states': n, '/voltage_command': n, '/plant_state': n, '/safety_event': 1}
 
 
 def test_a_file_cut_short_is_read_up_to_its_last_complete_chunk(tmp_path):

@@ -84,7 +84,13 @@ def test_wrapped_and_hanging_angles_map_to_upright():
     assert np.array_equal(same, th) and notes == []
 
 
-def test_a_record_that_leaves_upright_is_refused(tmp_path):
-    (tmp_path / 'swing.csv').write_text(table(theta=np.linspace(0.0, 2.0, N)))
-    with pytest.raises(ConfigError, match='leaves'):
-        load(tmp_path / 'swing.csv', None)
+def test_the_angle_zero_can_be_named(tmp_path):
+    """A log that swings up from hanging is read (analysis finds its balanced part); its zero
+    can be given instead of recognised."""
+    th = np.linspace(np.pi, 0.0, N)          # from hanging to upright, measured from upright
+    (tmp_path / 'swing.csv').write_text(table(theta=th))
+    assert np.allclose(load(tmp_path / 'swing.csv', None, angle_zero='upright').theta, th)
+    (tmp_path / 'hang.csv').write_text(table(theta=th + np.pi))
+    assert np.allclose(load(tmp_path / 'hang.csv', None, angle_zero='hanging').theta, th)
+    with pytest.raises(ConfigError, match='angle zero'):
+        load(tmp_path / 'hang.csv', None, angle_zero='sideways')

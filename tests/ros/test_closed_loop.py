@@ -87,8 +87,8 @@ def test_recorded_counts_equal_published_counts(runs):
     n = res.samples
     assert res.published == {'/clock': n, 'joint_states': n, 'plant_state': n, 'safety_event': 2}
     assert res.counts_match
-    assert bag.counts == {'/clock': n, 'joint_states': n, 'plant_state': n, 'voltage_command': n,
-                          'safety_event': 2, 'controller_gain': 1}
+    assert bag.counts == {'/clock': n, '/joint_states': n, '/plant_state': n, '/voltage_command': n,
+                          '/safety_event': 2, '/controller_gain': 1}
     # the controller's own count (logged at its shutdown) equals the recorded commands
     log = (res.out and open(f'{res.out}/logs/controller_node.log').read())
     assert f'published {n} commands' in log
@@ -122,7 +122,7 @@ def test_bag_is_rosbag2_mcap_with_configuration(runs):
     for path in (Path(res.bag), mcap_path):       # as a bag and as a bare file
         with AnyReader([path], default_typestore=store) as r:
             assert {c.topic: c.msgcount for c in r.connections} == bag.counts
-            conn = [c for c in r.connections if c.topic == 'plant_state'][0]
+            conn = [c for c in r.connections if c.topic == '/plant_state'][0]
             first = next(r.messages(connections=[conn]))
             assert r.deserialize(first[2], conn.msgtype).sample_index == 0
 

@@ -24,6 +24,7 @@ from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import Clock, ClockType
 from rclpy.duration import Duration
 from rclpy.executors import SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import JointState
@@ -53,6 +54,12 @@ class ControllerNode(Node):
             self, 'controller_node', 'min_command_subscribers', 1,
             'publish controller_gain (ready) once voltage_command has this many subscriptions', (1, 100),
             read_only=True)
+        self.executor_kind = declare(
+            self, 'controller_node', 'executor', 'single_threaded',
+            'rclpy executor: ' + ' | '.join(EXECUTORS), read_only=True)
+        if self.executor_kind not in EXECUTORS:
+            raise ConfigError(f'controller_node.ros__parameters.executor: {self.executor_kind!r}; '
+                              f'allowed {", ".join(EXECUTORS)}')
         check_unknown(self, 'controller_node')
 
         c = self.scenario.controller
@@ -172,6 +179,10 @@ class ControllerNode(Node):
             self.get_logger().warning(f'{topics.VOLTAGE_COMMAND}: not all commands acknowledged in {timeout:g} s')
 
 
+#: The executors controller_node can spin with (parameter ``executor``).
+EXECUTORS = {'single_threaded': SingleThreadedExecutor, 'events': EventsExecutor}
+
+
 def main(args=None) -> int:
     with node_process('controller_node', args) as proc:
         try:
@@ -179,7 +190,7 @@ def main(args=None) -> int:
         except ConfigError as exc:
             proc.logger.fatal(f'configuration error: {exc}')
             return 2
-        executor = SingleThreadedExecutor()
+        executor = EXECUTORS[node.executor_kind]()
         executor.add_node(node)
         while not proc.stop:
             executor.spin_once(timeout_sec=0.1)

@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from .design.paperconfig import DEFAULT_CONFIG, DEFAULT_DATA, REPO_ROOT, load_paper_config
+from .ident.records import ANGLE_ZEROS
 from .physics.params import ConfigError
 
 
@@ -142,6 +143,42 @@ def _print_analysis(r: dict) -> None:
         print(f'  period: {pc and round(pc, 3)} s (zero crossings), {ps and round(ps, 3)} s (spectrum)'
               + ('' if r['periods_agree'] else ': estimates disagree, an irregular oscillation')
               + (f'; {r["frequency"]:.3f} Hz' if r['frequency'] else ''))
+    if r.get('samples_without_command') is not None:
+        lat = r.get('command_latency_s') or {}
+        print(f'  {r["time_mode"]}: {r["samples_without_command"]} samples without a fresh command '
+              f'({100 * r["samples_without_command"] / r["samples"]:.2f} %)'
+              + (f'; command latency median {lat["median"] * 1e3:.3f} ms, p99 {lat["p99"] * 1e3:.3f} ms, '
+                 f'max {lat["max"] * 1e3:.3f} ms' if lat.get('median') is not None else ''))
+    if 'figure' in r:
+        print(f'  figure: {r["figure"]}')
+
+
+def _column_map(text: str | None) -> dict:
+    """--columns t=time_s,x=cart_m,... as name -> CSV header."""
+    columns = {}
+    for item in text.split(',') if text else []:
+        key, _, name = item.partition('=')
+        if not name:
+            raise ConfigError(f'--columns: {item!r} is not NAME=HEADER (names t, x, voltage, theta)')
+        columns[key.strip()] = name.strip()
+    return columns
+
+
+LOG_SUFFIXES = ('.csv', '.mat')
+
+
+def _print_log_analysis(r: dict) -> None:
+    """Readable summary of one :func:`analysis.analyze_log` result: a row per regime."""
+    print(f'{r["path"]}: {r["samples"]} samples, {r["duration_s"]:.2f} s every {r["sample_period_s"] * 1e3:.3g} ms, '
+          f'angle from {r["angle_zero"]}; {len(r["segments"])} balanced stretch(es)')
+    for i, seg in enumerate(r['segments'], 1):
+        print(f'  stretch {i}: {seg["start"]:.2f}-{seg["end"]:.2f} s, ends {seg["class"]}')
+        for g in seg['regimes']:
+            pc, ps = g['period_crossings'], g['period_spectrum']
+            period = f'; period {pc:.3f} s (crossings), {ps:.3f} s (spectrum)' if pc and ps else ''
+            print(f'    {g["start"]:7.2f}-{g["end"]:7.2f} s  {g["cls"]:<11}  cart p2p {g["x_p2p"] * 100:.2f} cm, '
+                  f'angle p2p {math.degrees(g["theta_p2p"]):.3f} deg, cart at rest {100 * g["stick_fraction"]:.0f} %'
+                  + period)
     if 'figure' in r:
         print(f'  figure: {r["figure"]}')
 
@@ -149,8 +186,21 @@ def _print_analysis(r: dict) -> None:
 def cmd_analyze(args) -> int:
     """Exit code 0: every bag intact; 1: a bag truncated or damaged (what was read is analysed,
     the loss stated); 2: an input refused (not an MCAP file, no bag)."""
-    from .analysis.recorded_run import analyze_run, overlay_runs
-    results = [analyze_run(p, None if args.no_plots else args.plots) for p in args.runs]
+    from .analysis.recorded_run import analyze_log, analyze_run, overlay_runs
+    plots = None if args.no_plots else args.plots
+    logs = [p for p in args.runs if Path(p).suffix.lower() in LOG_SUFFIXES]
+    if logs and len(logs) != len(args.runs):
+        raise ConfigError('give either rig logs (.csv, .mat) or runs (bags), not both')
+    if logs:
+        columns = _column_map(args.columns)
+        results = [analyze_log(p, columns, args.angle_zero, math.radians(args.max_angle_deg),
+                               args.min_balanced_s, plots) for p in logs]
+        if args.json:
+            _print_json({'logs': results})
+        for r in [] if args.json else results:
+            _print_log_analysis(r)
+        return 0
+    results = [analyze_run(p, plots) for p in args.runs]
     out: dict = {'runs': results}
     if len(args.runs) > 1 and not args.no_plots:
         out['overlay'] = overlay_runs(args.runs, Path(args.plots) / 'overlay.png')
@@ -276,6 +326,7 @@ def _threshold(args, out: Path) -> int:
 
 
 def cmd_sweep(args) -> int:
+    from .analysis.oscillation import CLASSES
     from .analysis.plots import stability_map
     from .analysis.sweep import boundaries, grid, parse_range, print_progress, sweep
     try:
@@ -310,8 +361,7 @@ def cmd_sweep(args) -> int:
     summary = {'config': args.config, 'sensors': args.sensors, 'duration_s': args.duration,
                'path': 'ros lockstep' if args.ros else 'offline',
                'cells': len(rows), 'figure': str(fig), 'csv': str(out / 'cells.csv'),
-               'counts': {c: sum(r['class'] == c for r in rows)
-                          for c in ('settled', 'limit_cycle', 'growing', 'fallen')},
+               'counts': {c: sum(r['class'] == c for r in rows) for c in CLASSES},
                'boundaries': boundaries(rows, taus, ths)}
     (out / 'summary.json').write_text(json.dumps(summary, indent=2, default=float))
     if args.json:
@@ -373,12 +423,7 @@ def cmd_identify(args) -> int:
               f'{rep["residual_curvature_N"]:+.4f} N')
         return 0
     from .ident.records import load
-    columns = {}
-    for item in args.columns.split(',') if args.columns else []:
-        key, _, name = item.partition('=')
-        if not name:
-            raise ConfigError(f'--columns: {item!r} is not NAME=HEADER (names t, x, voltage, theta)')
-        columns[key.strip()] = name.strip()
+    columns = _column_map(args.columns)
     rec = load(args.data, plant, columns, args.cart_alone)
     allowed = None
     if args.effects:
@@ -507,11 +552,19 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument('--out', required=True, help='output directory: bag/, scenario.yaml, logs/, summary.json')
     r.add_argument('--domain', type=int, default=None, help='ROS_DOMAIN_ID (default: a free one in 1..232)')
     r.add_argument('--timeout', type=float, default=None, help='stop the run after this many wall seconds')
-    a = add('analyze', cmd_analyze, 'classify recorded runs (settled, limit cycle, growing, fallen): amplitude, '
-            'period, sticking, plots; reads rosbag2 directories, run directories or .mcap files without ROS')
-    a.add_argument('runs', nargs='+', help='run directory, rosbag2 directory or .mcap file')
+    a = add('analyze', cmd_analyze, 'classify recorded runs (settled, limit cycle, irregular, growing, fallen): '
+            'amplitude, period, sticking, plots; reads rosbag2 directories, run directories or .mcap files '
+            'without ROS, and rig logs (.csv, .mat as identify reads them) per balanced stretch')
+    a.add_argument('runs', nargs='+', help='run directory, rosbag2 directory, .mcap file, or a rig log .csv/.mat')
     a.add_argument('--plots', default='runs/analysis', help='directory for PNG figures (default %(default)s)')
     a.add_argument('--no-plots', action='store_true', help='numbers only')
+    a.add_argument('--columns', help='rig log: CSV column mapping, e.g. t=time_s,x=cart_m,voltage=u_V,theta=angle_rad')
+    a.add_argument('--angle-zero', choices=ANGLE_ZEROS, default='auto',
+                   help='rig log: where its angle is zero (default %(default)s: hanging if mostly far from upright)')
+    a.add_argument('--max-angle-deg', type=float, default=20.0,
+                   help='rig log: balanced while |theta| from upright is below this (default %(default)s deg)')
+    a.add_argument('--min-balanced-s', type=float, default=2.0,
+                   help='rig log: shortest balanced stretch analysed (default %(default)s s)')
     w = add('sweep', cmd_sweep, 'stability map over the delay tau and the initial angle theta0 (Figures 11-12), '
             'offline physics core, parallel and resumable')
     w.add_argument('--config', default=str(REPO_ROOT / 'config' / 'fig9_new_gain_exponential.yaml'),

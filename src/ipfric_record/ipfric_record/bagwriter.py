@@ -2,9 +2,10 @@
 
 Layout as ``ros2 bag record -s mcap`` writes it (rosbag2 format version 9):
 
-- ``<dir>/<dir name>.mcap``: profile ``ros2``; one schema per message type (encoding
+- ``<dir>/<dir name>_0.mcap``: profile ``ros2``; one schema per message type (encoding
   ``ros2msg``, the .msg text with its dependencies as rosbag2 concatenates them); one
-  channel per topic (message encoding ``cdr``, channel metadata ``offered_qos_profiles``);
+  channel per fully qualified topic name (message encoding ``cdr``, channel metadata
+  ``offered_qos_profiles`` and ``topic_type_hash``, the type's RIHS01 hash);
   chunked messages with message indexes; a summary with Statistics, chunk indexes and a
   metadata index; metadata records ``rosbag2`` (``serialized_metadata``, the bag
   information as YAML) and, here, ``ipfric`` (the run configuration).
@@ -60,7 +61,7 @@ class BagWriter:
         if self.path.exists():
             raise FileExistsError(f'{self.path} exists already; not overwriting')
         self.path.mkdir(parents=True)
-        self.file = self.path / f'{self.path.name}.mcap'
+        self.file = self.path / f'{self.path.name}_0.mcap'
         self.store = typestore
         self.custom_data = dict(custom_data or {})
         self.metadata = dict(metadata or {})
@@ -74,15 +75,18 @@ class BagWriter:
         self.closed = False
 
     def add_topic(self, topic: str, msgtype: str, qos: dict) -> int:
-        """Register a topic of ROS type ``msgtype`` (e.g. 'sensor_msgs/msg/JointState')."""
+        """Register a topic (fully qualified, e.g. '/joint_states') of ROS type ``msgtype``
+        (e.g. 'sensor_msgs/msg/JointState')."""
+        if not topic.startswith('/'):
+            raise ValueError(f'topic {topic!r}: give the fully qualified name ("/{topic}"), as rosbag2 records it')
         if msgtype not in self._schemas:
             msgdef, _ = self.store.generate_msgdef(msgtype, ros_version=2)
             self._schemas[msgtype] = self._mcap.register_schema(msgtype, 'ros2msg', msgdef.encode())
-        qos_yaml = _yaml([qos]).strip()
+        type_hash = self.store.hash_rihs01(msgtype)
         cid = self._mcap.register_channel(topic, 'cdr', self._schemas[msgtype],
-                                          {'offered_qos_profiles': qos_yaml})
-        self.topics[topic] = {'id': cid, 'type': msgtype, 'qos': qos, 'count': 0,
-                              'hash': self.store.hash_rihs01(msgtype)}
+                                          {'offered_qos_profiles': _yaml([qos]).strip(),
+                                           'topic_type_hash': type_hash})
+        self.topics[topic] = {'id': cid, 'type': msgtype, 'qos': qos, 'count': 0, 'hash': type_hash}
         return cid
 
     def write(self, topic: str, time_ns: int, data) -> None:

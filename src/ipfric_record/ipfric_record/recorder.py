@@ -2,8 +2,10 @@
 
 Subscribes ``/clock``, ``joint_states``, ``plant_state``, ``voltage_command``,
 ``safety_event`` and ``controller_gain`` as raw (serialized CDR) messages and writes them
-unchanged into a rosbag2 directory (:class:`ipfric_record.bagwriter.BagWriter`):
-``<output>/metadata.yaml`` and ``<output>/<name>.mcap`` with a schema for every channel,
+unchanged, under their resolved names (``/joint_states``; ``/ns/joint_states`` when the
+recorder runs in namespace ``/ns``), into a rosbag2 directory
+(:class:`ipfric_record.bagwriter.BagWriter`):
+``<output>/metadata.yaml`` and ``<output>/<name>_0.mcap`` with a schema for every channel,
 message indexes and a Statistics record, as rosbag2 itself writes them. Each message is
 stamped with the recorder's wall clock when it is taken (as ``ros2 bag record`` does),
 never decreasing; the header stamps carry the simulated time.
@@ -77,10 +79,11 @@ class Recorder(Node):
         self._last_ns = 0
         for name, (cls, type_name, latched) in topics.run_topics().items():
             depth = 1 if latched else (100 if name == topics.SAFETY_EVENT else topics.DATA_DEPTH)
-            self.writer.add_topic(name, type_name, qos_dict(depth=depth, transient_local=latched))
+            resolved = self.resolve_topic_name(name)
+            self.writer.add_topic(resolved, type_name, qos_dict(depth=depth, transient_local=latched))
             qos = topics.latched_qos() if latched else topics.data_qos(topics.RECORD_DEPTH)
-            sub = self.create_subscription(cls, name, self._writer_for(name), qos, raw=True)
-            self.subs.append((sub, name))
+            sub = self.create_subscription(cls, name, self._writer_for(resolved), qos, raw=True)
+            self.subs.append((sub, resolved))
         self.get_logger().info(f'recording {len(self.subs)} topics to {self.path}')
 
     def _log_time(self) -> int:

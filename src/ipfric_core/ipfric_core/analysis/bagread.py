@@ -1,6 +1,8 @@
 """Read an ipfric run back from its MCAP file, without a ROS runtime, trusting no byte.
 
-Accepts a rosbag2 directory (metadata.yaml + .mcap) or a bare .mcap file. The file is
+Accepts a rosbag2 directory (metadata.yaml + ``bag_0.mcap``, or ``bag.mcap`` of older runs) or a
+bare .mcap file; topics match with or without the leading ``/`` and are counted under their
+fully qualified names. The file is
 memory-mapped and walked record by record; every length is checked against the end of its
 record, chunk and file before it is followed (in the compiled scanner too).
 
@@ -517,7 +519,7 @@ def read_run(path: str | Path, keep=tuple(SCANNED)) -> RunData:
     if r.bad_messages:
         r.damage.append((f'{r.bad_messages} message(s) did not decode or did not fit in their record', None))
     config = _config(r)
-    counts = {r.channels[c].topic: int(r.counts[c]) for c in sorted(r.channels) if r.counts[c]}
+    counts = {'/' + r.channels[c].topic.lstrip('/'): int(r.counts[c]) for c in sorted(r.channels) if r.counts[c]}
     j, c, tr = (o[:k] for o, k in zip(r.out, r.n))
     damage = [_located(s, k, j[:, 0]) for s, k in r.damage]
     j, tr = _physical(j, 'joint_states', damage), _physical(tr, 'plant_state', damage)

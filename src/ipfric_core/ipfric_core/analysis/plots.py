@@ -12,16 +12,24 @@ import numpy as np  # noqa: E402
 
 from ..constants import ANGLE_RESOLUTION_RAD  # noqa: E402
 
-CLASS_COLOURS = {'settled': '#2b8cbe', 'limit_cycle': '#fdae61', 'growing': '#f46d43', 'fallen': '#d7191c'}
+CLASS_COLOURS = {'settled': '#2b8cbe', 'limit_cycle': '#fdae61', 'irregular': '#abdda4', 'growing': '#f46d43',
+                 'fallen': '#d7191c'}
 
 
-def run_figure(t, x, theta, voltage_t, voltage, title: str, path: str | Path, phase=None) -> Path:
+def run_figure(t, x, theta, voltage_t, voltage, title: str, path: str | Path, phase=None, spans=()) -> Path:
     """Cart position, angle and voltage against time (Figures 7-10), and the phase portrait.
 
     ``phase`` = (theta [rad], theta' [rad/s]) for the portrait, e.g. the ground truth; by
-    default the encoder angle and its centred difference.
+    default the encoder angle and its centred difference. ``spans``: (start [s], end [s],
+    class) of regimes, shaded in the class colour behind the cart position.
     """
     fig, ax = plt.subplots(2, 2, figsize=(11, 6.5))
+    for a, b, cls in spans:
+        ax[0, 0].axvspan(a, b, color=CLASS_COLOURS[cls], alpha=0.3, lw=0, label=cls.replace('_', ' '))
+    if spans:
+        handles, labels = ax[0, 0].get_legend_handles_labels()
+        unique = dict(zip(labels, handles))
+        ax[0, 0].legend(unique.values(), unique.keys(), fontsize=7, loc='upper right')
     ax[0, 0].plot(t, x, lw=0.8)
     ax[0, 0].set(xlabel='time (s)', ylabel='position (m)', title='cart position')
     ax[1, 0].plot(t, np.degrees(theta), lw=0.8, color='C1')

@@ -1,6 +1,13 @@
-"""Offline analysis of recorded runs: class, amplitude, period, sticking, plots."""
+"""Offline analysis of recorded runs and rig logs: class, amplitude, period, sticking, plots.
+
+A run's bag (:func:`analyze_run`) is judged by its final regime; a rig's log (CSV or
+MATLAB, :func:`analyze_log`) is cut into the stretches where the pendulum is balanced
+and each into regimes (:func:`ipfric_core.analysis.oscillation.regimes`).
+"""
 from __future__ import annotations
 
+import json
+import math
 import re
 from pathlib import Path
 
@@ -15,8 +22,9 @@ from ..constants import (
     PLANT_STATE,
     VOLTAGE_COMMAND,
 )
+from ..physics.params import ConfigError
 from .bagread import RunData, read_run
-from .oscillation import classify
+from .oscillation import balanced_segments, classify, regimes
 from .plots import overlay_figure, run_figure
 
 
@@ -48,7 +56,7 @@ def analyze_run(path: str | Path, plot_dir: str | Path | None = None, window: fl
            'end_reason': run.end_reason, 'truncated': run.truncated,
            'truncation_detail': run.truncation_detail, 'damage': run.damage, 'counts': run.counts,
            'gain': run.gain,
-           **{('class' if k == 'cls' else k): v for k, v in o.to_dict().items()}}
+           **{('class' if k == 'cls' else k): v for k, v in o.to_dict().items()}, **loop_timing(path)}
     if plot_dir is not None:
         d = Path(plot_dir)
         d.mkdir(parents=True, exist_ok=True)
@@ -60,6 +68,23 @@ def analyze_run(path: str | Path, plot_dir: str | Path | None = None, window: fl
         out['figure'] = str(run_figure(run.t, run.x, run.theta, run.command_t, run.voltage, title,
                                        d / f'{name}.png', phase))
     return out
+
+
+def loop_timing(path: str | Path) -> dict:
+    """What sim_node measured of the loop (``sim_result.json`` of a run directory, beside
+    or above the bag): time mode, samples at which no fresh command had arrived (the held
+    command was applied: an extra sample of delay the plant saw) and the command latency
+    [s]; empty for a bag without it."""
+    p = Path(path)
+    for d in (p, p.parent, p.parent.parent):
+        f = d / 'sim_result.json'
+        if f.is_file():
+            try:
+                sim = json.loads(f.read_text())
+            except ValueError:
+                return {}
+            return {k: sim.get(k) for k in ('time_mode', 'samples_without_command', 'command_latency_s')}
+    return {}
 
 
 def alignment_shift(t_ref, x_ref, t, x) -> tuple[float, float]:
@@ -95,3 +120,41 @@ def overlay_runs(paths, plot_path: str | Path) -> dict:
     fig = overlay_figure([(r.t, r.x) for r in runs], [Path(p).name for p in paths], shifts, plot_path)
     return {'figure': str(fig), 'shifts': [{'path': str(p), 'time_s': s[0], 'position_m': s[1]}
                                            for p, s in zip(paths, shifts)]}
+
+
+def count_size(y) -> float:
+    """The smallest step of a sampled signal: its encoder count when it is quantized."""
+    d = np.abs(np.diff(np.asarray(y, float)))
+    d = d[d > 0]
+    return float(d.min()) if len(d) else 0.0
+
+
+def analyze_log(path: str | Path, columns: dict | None = None, angle_zero: str = 'auto',
+                max_angle: float = math.radians(20.0), min_duration: float = 2.0,
+                plot_dir: str | Path | None = None) -> dict:
+    """A rig's log (the formats of ``identify``: CSV t, x, voltage, theta; ``columns``
+    maps names to headers) cut into balanced stretches (|theta| < ``max_angle`` [rad] for
+    at least ``min_duration`` [s]), each into regimes: class, time span, cart and angle
+    peak-to-peak, period by zero crossings and by spectrum, sticking."""
+    from ..ident.records import load
+    rec = load(path, None, columns, angle_zero=angle_zero)
+    if rec.theta is None:
+        raise ConfigError(f'{path}: no pendulum angle in the file; analyze needs t, x and theta '
+                          f'(map a CSV column with --columns theta=NAME)')
+    theta = rec.theta
+    zero = 'hanging' if any('hanging' in n for n in rec.notes) else 'upright'
+    resolution = (count_size(rec.x), count_size(theta))
+    segments = []
+    for a, b in balanced_segments(rec.t, theta, max_angle, min_duration):
+        parts = regimes(rec.t[a:b], rec.x[a:b], theta[a:b], resolution)
+        segments.append({'start': float(rec.t[a]), 'end': float(rec.t[b - 1]), 'class': parts[-1].cls,
+                         'regimes': [r.to_dict() for r in parts]})
+    out = {'path': str(path), 'samples': int(len(rec.t)), 'duration_s': float(rec.t[-1] - rec.t[0]),
+           'sample_period_s': rec.dt, 'angle_zero': zero, 'count_size': list(resolution), 'segments': segments}
+    if plot_dir is not None:
+        d = Path(plot_dir)
+        d.mkdir(parents=True, exist_ok=True)
+        spans = [(r['start'], r['end'], r['cls']) for s in segments for r in s['regimes']]
+        out['figure'] = str(run_figure(rec.t, rec.x, theta, rec.t, rec.u, f'{Path(path).name}: {len(segments)} '
+                                       f'balanced stretch(es)', d / f'{Path(path).stem}.png', spans=spans))
+    return out

@@ -10,6 +10,7 @@ import importlib
 
 #: public name -> module that defines it
 _WHERE = {
+    'ANGLE_ZEROS': 'records',
     'BASE_MODELS': 'effects',
     'BASE_PARAMS': 'effects',
     'BINS': 'residual',
@@ -50,6 +51,7 @@ _WHERE = {
     'Prepared': 'equation_error',
     'Problem': 'ladder',
     'REFIT_NOTE': 'ladder',
+    'REST_SPAN': 'shooting',
     'Record': 'records',
     'SCREEN_GAIN': 'ladder',
     'SIGNATURES': 'residual',

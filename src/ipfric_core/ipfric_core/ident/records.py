@@ -110,14 +110,20 @@ def overruns(t: np.ndarray, readings: list) -> np.ndarray:
     return valid
 
 
-def upright_angle(theta: np.ndarray) -> tuple[np.ndarray, list[str]]:
-    """theta from upright [rad]: unwrapped, and shifted by pi when measured from hanging."""
+ANGLE_ZEROS = ('auto', 'upright', 'hanging')
+
+
+def upright_angle(theta: np.ndarray, zero: str = 'auto') -> tuple[np.ndarray, list[str]]:
+    """theta from upright [rad]: unwrapped, and shifted by pi when measured from hanging
+    (``zero`` 'hanging', or 'auto' when its median lies more than pi/2 from upright)."""
+    if zero not in ANGLE_ZEROS:
+        raise ConfigError(f'angle zero {zero!r} is not one of {", ".join(ANGLE_ZEROS)}')
     notes = []
     th = np.unwrap(theta)
     if np.any(np.abs(np.diff(theta)) > np.pi):
         notes.append('angle wrapped at +/-pi: unwrapped')
     turns = np.round(np.median(th) / (2 * np.pi))
-    if np.median(np.abs(th - 2 * np.pi * turns)) > np.pi / 2:
+    if zero == 'hanging' or (zero == 'auto' and np.median(np.abs(th - 2 * np.pi * turns)) > np.pi / 2):
         th = th - np.pi
         notes.append('angle measured from hanging (pi at upright): mapped to upright = 0')
     turns = np.round(np.median(th) / (2 * np.pi))
@@ -126,7 +132,7 @@ def upright_angle(theta: np.ndarray) -> tuple[np.ndarray, list[str]]:
     return th, notes
 
 
-def check_record(rec: Record) -> Record:
+def check_record(rec: Record, angle_zero: str = 'auto') -> Record:
     """Refuse what cannot be measured data (NaN, time going back, absurd ranges, too few
     samples); take what rigs write (uneven stamps, overruns, wrapped or hanging angles)."""
     n = len(rec.t)
@@ -170,11 +176,8 @@ def check_record(rec: Record) -> Record:
         if np.max(np.abs(theta)) > 2 * np.pi and off_axis > 0.5:
             raise ConfigError(f'{rec.name}: column theta reaches {np.max(np.abs(theta)):g}; expected radians '
                               f'from upright or from hanging (degrees?)')
-        theta, found = upright_angle(theta)
+        theta, found = upright_angle(theta, angle_zero)
         notes += found
-        if np.max(np.abs(theta)) > np.pi / 2:
-            raise ConfigError(f'{rec.name}: column theta leaves +/-90 deg of upright (to {np.max(np.abs(theta)):g} '
-                              f'rad); cut the record to the balanced part')
     valid = overruns(rec.t, [rec.x] + ([theta] if theta is not None else []))
     if not valid.all():
         notes.append(f'{int((~valid).sum())} stale readings after {int(np.sum(np.diff(valid.astype(int)) == -1))} '
@@ -185,12 +188,12 @@ def check_record(rec: Record) -> Record:
     return replace(rec, theta=theta, valid=valid, notes=tuple(notes))
 
 
-def _rig_record(name, t, x, u, theta, plant: PlantParams) -> Record:
+def _rig_record(name, t, x, u, theta, plant: PlantParams, angle_zero: str = 'auto') -> Record:
     pend = None if theta is None else (plant.m, plant.l, plant.g)
     fn = plant.normal_force if theta is not None else plant.M * plant.g
     return check_record(Record(name, np.asarray(t, float), np.asarray(x, float), np.asarray(u, float),
                                plant.alpha, plant.beta, None if theta is None else np.asarray(theta, float),
-                               pend, fn, stick_velocity=2e-3, cutoff_hz=25.0))
+                               pend, fn, stick_velocity=2e-3, cutoff_hz=25.0), angle_zero)
 
 
 def _text_lines(path: Path):
@@ -211,7 +214,7 @@ def _text_lines(path: Path):
         stream.close()
 
 
-def load_csv(path: str | Path, plant: PlantParams, columns: dict | None = None) -> Record:
+def load_csv(path: str | Path, plant: PlantParams, columns: dict | None = None, angle_zero: str = 'auto') -> Record:
     """CSV (or .csv.gz) with a header: t [s], x [m], voltage [V] and optionally theta [rad].
 
     ``columns`` maps these names to the file's headers, e.g. {'x': 'cart_m'}. Lines that
@@ -255,7 +258,7 @@ def load_csv(path: str | Path, plant: PlantParams, columns: dict | None = None) 
     if rows == 0:
         raise ConfigError(f'{path}: a header and no data rows; expected rows of {", ".join(header)}')
     arrays = {n: np.frombuffer(data[n], float) for n in names}
-    return _rig_record(path.name, arrays['t'], arrays['x'], arrays['voltage'], arrays.get('theta'), plant)
+    return _rig_record(path.name, arrays['t'], arrays['x'], arrays['voltage'], arrays.get('theta'), plant, angle_zero)
 
 
 def load_bag(path: str | Path, plant: PlantParams | None = None, cart_alone: bool = False) -> Record:
@@ -302,13 +305,14 @@ def load_emps(path: str | Path) -> Record:
 
 
 def load(path: str | Path, plant: PlantParams | None, columns: dict | None = None,
-         cart_alone: bool = False) -> Record:
+         cart_alone: bool = False, angle_zero: str = 'auto') -> Record:
     """Pick the loader from the file: .csv, .mat (EMPS), else a bag (directory or .mcap).
 
-    ``plant`` None: a bag's stored scenario, Table 1 for a CSV."""
+    ``plant`` None: a bag's stored scenario, Table 1 for a CSV. ``angle_zero``: where a CSV's
+    angle is measured from (:data:`ANGLE_ZEROS`)."""
     p = Path(path)
     if p.suffix.lower() == '.csv' or p.name.lower().endswith('.csv.gz'):
-        return load_csv(p, plant or PlantParams(), columns)
+        return load_csv(p, plant or PlantParams(), columns, angle_zero)
     if p.suffix.lower() == '.mat':
         return load_emps(p)
     if not p.exists():

@@ -1,14 +1,15 @@
 """A run scenario (a ROS 2 parameter file) and the supervisor of the node processes.
 
-Modules: runner, scenario. Every public name below is loaded from its module on first use,
-so importing the package stays cheap."""
+Modules: nodes, runner, scenario. Every public name below is loaded from its module on first
+use, so importing the package stays cheap."""
 from __future__ import annotations
 
 import importlib
 
 #: public name -> module that defines it
 _WHERE = {
-    'CONFIG_NAME': 'runner',
+    'BAG_NAME': 'nodes',
+    'CONFIG_NAME': 'nodes',
     'CONTROLLER_FIELDS': 'scenario',
     'ControllerSettings': 'scenario',
     'DEFAULT_Q': 'scenario',
@@ -17,10 +18,12 @@ _WHERE = {
     'EXIT_FELL': 'runner',
     'GAIN': 'scenario',
     'GAIN_SOURCES': 'scenario',
-    'NODES': 'runner',
+    'NODES': 'nodes',
+    'OVERRIDES': 'nodes',
     'PLANT_TRUTH_FIELDS': 'scenario',
     'PR_SET_PDEATHSIG': 'runner',
     'RECORDER_PARAMS': 'scenario',
+    'RESULT_NAME': 'nodes',
     'ROOT': 'runner',
     'Run': 'runner',
     'RunResult': 'runner',
@@ -37,16 +40,20 @@ _WHERE = {
     'last_problem': 'runner',
     'load_scenario': 'scenario',
     'nest': 'scenario',
+    'node_parameters': 'nodes',
     'parse_controller': 'scenario',
+    'parse_overrides': 'nodes',
     'parse_sim': 'scenario',
     'pick_domain': 'runner',
+    'ros_args': 'nodes',
     'ros_environment': 'runner',
     'run': 'runner',
     'scenario_from_ros_params': 'scenario',
     'sim_faults': 'runner',
+    'write_run_scenario': 'nodes',
 }
 
-__all__ = sorted(_WHERE) + ['runner', 'scenario']
+__all__ = sorted(_WHERE) + ['nodes', 'runner', 'scenario']
 
 
 def __getattr__(name: str):

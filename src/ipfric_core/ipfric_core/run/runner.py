@@ -21,7 +21,7 @@ Exit codes: 0 clean; 1 a node failed; 2 bad input (nothing started); 3 a safety 
 (watchdog, stalled controller, refused commands, unexpected publisher); 4 the pendulum
 fell or the cart reached the track limit; 130 stopped by Ctrl-C/SIGTERM/SIGHUP.
 
-Output directory ``OUT``: ``bag/`` (metadata.yaml + bag.mcap), ``scenario.yaml`` (the
+Output directory ``OUT``: ``bag/`` (metadata.yaml + bag_0.mcap), ``scenario.yaml`` (the
 parameter file the nodes got, duration applied), ``sim_result.json`` (end reason, samples,
 published counts, speed), ``summary.json`` and ``logs/<node>.log``.
 
@@ -45,18 +45,11 @@ from pathlib import Path
 import yaml
 
 from ..constants import LIMITS
-from ..physics.params import ConfigError, load_yaml
-from .scenario import load_scenario
+from ..physics.params import ConfigError
+from .nodes import NODES, node_parameters, ros_args, write_run_scenario
 
 ROOT = Path(os.environ.get('IPFRIC_ROOT') or Path(__file__).resolve().parents[4])
 
-#: The processes of a run in start order: name -> (package, executable).
-NODES = {
-    'recorder': ('ipfric_record', 'recorder'),
-    'controller_node': ('ipfric_controller', 'controller_node'),
-    'sim_node': ('ipfric_sim', 'sim_node'),
-}
-CONFIG_NAME = 'scenario.yaml'
 #: Exit codes of a run besides 0, 1 (a node failed), 2 (bad input) and 130 (Ctrl-C).
 EXIT_FAULT = 3    # a safety fault: watchdog, stall, refused commands, unexpected publisher
 EXIT_FELL = 4     # the pendulum fell or the cart reached the track limit (otherwise clean)
@@ -241,21 +234,8 @@ class Run:
             raise ConfigError(f'--timeout: {self.timeout!r} must be > 0 wall seconds')
         if self.out.exists() and not self.out.is_dir():
             raise ConfigError(f'--out: {self.out} is a file; give a directory (created if missing)')
-        load_scenario(self.config)
-        data = load_yaml(self.config)
-        if self.duration is not None:
-            if not (math.isfinite(self.duration) and self.duration >= 0):
-                raise ConfigError(f'--duration: {self.duration!r} must be >= 0 s')
-            data['sim_node']['ros__parameters']['duration'] = float(self.duration)
-        self.out.mkdir(parents=True, exist_ok=True)
-        if (self.out / 'bag').exists():
-            raise ConfigError(f'{self.out / "bag"} exists already; choose another --out')
-        path = self.out / CONFIG_NAME
-        header = f'# ipfric run of {self.config}' + (
-            f' with duration {self.duration:g} s' if self.duration is not None else '') + '\n'
-        path.write_text(header + yaml.safe_dump(data, sort_keys=False))
-        load_scenario(path)
-        return path
+        return write_run_scenario(self.config, self.out,
+                                  None if self.duration is None else {'duration': float(self.duration)})
 
     def start(self) -> None:
         cfg = self.prepare()
@@ -266,16 +246,9 @@ class Run:
         logdir.mkdir(exist_ok=True)
         env['ROS_LOG_DIR'] = str(logdir / 'ros')
         env[SUPERVISED] = '1'
-        sim_params = {'wait_for_recorder': 'true', 'result_file': str(self.out / 'sim_result.json')}
-        sim_params.update({k: str(v).lower() if isinstance(v, bool) else str(v)
-                           for k, v in self.sim_params.items()})
-        args = {
-            'recorder': ['-p', f'output:={self.out / "bag"}', '-p', f'scenario_file:={cfg}'],
-            'controller_node': ['--params-file', str(cfg), '-p', 'min_command_subscribers:=2',
-                                '-p', 'use_sim_time:=true'],
-            'sim_node': ['--params-file', str(cfg)] + [a for k, v in sim_params.items()
-                                                        for a in ('-p', f'{k}:={v}')],
-        }
+        params = node_parameters(cfg, self.out)
+        params['sim_node'][1].update(self.sim_params)
+        args = {name: ros_args(*params[name]) for name in NODES}
         self.t0 = time.monotonic()
         for name in NODES:
             exe = executable(name)
@@ -393,7 +366,7 @@ class Run:
         published = sim.get('published', {})
         match = None
         if published and recorded:
-            match = all(recorded.get(t) == n for t, n in published.items())
+            match = all(recorded.get('/' + t.lstrip('/')) == n for t, n in published.items())
         if match is False:
             lost = ', '.join(f'{t} {recorded.get(t, 0)} of {n}' for t, n in published.items()
                              if recorded.get(t) != n)

@@ -248,7 +248,8 @@ class Scenario:
         c = self.controller
         sim = {**asdict(self.sim), 'plant': asdict(self.plant), 'friction': self.friction.to_dict(),
                'plant_truth': self.truth.to_dict()}
-        ctrl = {'sample_rate_hz': c.sample_rate_hz, 'gain_source': c.gain_source, 'delay': c.delay,
+        ctrl = {'use_sim_time': True, 'sample_rate_hz': c.sample_rate_hz, 'gain_source': c.gain_source,
+                'delay': c.delay,
                 'cutoff_hz': c.cutoff_hz, 'voltage_limit': c.voltage_limit, 'plant': asdict(c.plant),
                 'Q': list(c.Q), 'R': c.R}
         if c.gain is not None:

@@ -1,0 +1,23 @@
+from glob import glob
+
+from setuptools import setup
+
+package_name = 'ipfric_bringup'
+
+setup(
+    name=package_name,
+    version='0.1.0',
+    packages=[],
+    data_files=[
+        ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
+        ('share/' + package_name, ['package.xml']),
+        ('share/' + package_name + '/launch', glob('launch/*.launch.py')),
+        ('share/' + package_name + '/plotjuggler', glob('plotjuggler/*.xml')),
+    ],
+    install_requires=['setuptools'],
+    zip_safe=True,
+    maintainer='ipfric maintainers',
+    maintainer_email='maintainers@ipfric.org',
+    description='Launch file of an ipfric run and a PlotJuggler layout of its topics.',
+    license='Apache-2.0',
+)
