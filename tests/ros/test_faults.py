@@ -11,6 +11,7 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 from rosrun import Peer, scenario_file
@@ -165,3 +166,29 @@ def test_a_rogue_flood_is_refused_counted_and_cannot_hold_the_simulator(tmp_path
     codes = [code for _, code, _ in bag.events]
     assert 'INTRUDER' in codes
     assert codes.count('BAD_COMMAND') <= 2 + 4 * 2   # per burst (about one a second), not per message
+
+
+def test_fake_measurements_from_a_second_publisher_are_refused_by_the_controller(tmp_path):
+    """A second writer on joint_states: the controller takes no measurement while it is there
+    (no command from fake positions), says so, and the run ends with a fault."""
+    from sensor_msgs.msg import JointState
+
+    from ipfric_ros import topics
+    cfg = scenario_file(tmp_path, 'default.yaml', sim={'duration': 3.0})
+    r = Run(cfg, tmp_path / 'run', timeout=300)
+    r.start()
+    peer = None
+    try:
+        started(r.logs['sim_node'], r.procs['sim_node'])
+        peer = Peer('fake_encoders', domain=r.domain)
+        pub = peer.node.create_publisher(JointState, topics.JOINT_STATES, topics.data_qos())
+        while r.procs['sim_node'].poll() is None:
+            pub.publish(JointState(name=list(topics.JOINT_NAMES), position=[0.0, 0.4]))   # a "fallen" angle
+            time.sleep(1e-3)
+        res = r.wait()
+    finally:
+        if peer is not None:
+            peer.close()
+        r.kill()
+    assert res.exit_code != 0, res.summary()     # 3 when the simulator caught the writer, else 1 (counts)
+    assert 'measurements refused' in Path(r.logs['controller_node']).read_text()

@@ -43,6 +43,8 @@ from ipfric_ros.signals import node_process
 RUNTIME_PARAMETERS = ('delay', 'gain', 'cutoff_hz', 'voltage_limit')
 
 
+WRITER_CHECK = 100   # samples between checks that joint_states has a single publisher
+
 class ControllerNode(Node):
     """StateFeedback behind ROS topics and parameters."""
 
@@ -84,6 +86,8 @@ class ControllerNode(Node):
         self.ready = False
         self.published = 0
         self.rejected = 0
+        self._seen = 0       # measurements received
+        self._writers = 1    # publishers on joint_states at the last check
         self.last_index = None
         self._names = None
         self._index = (0, 1)
@@ -144,6 +148,15 @@ class ControllerNode(Node):
     # -- control ---------------------------------------------------------------------------
     def _on_joints(self, msg: JointState) -> None:
         if not self.ready:
+            return
+        self._seen += 1
+        if self._seen % WRITER_CHECK == 1:   # a graph query every WRITER_CHECK samples
+            self._writers = self.count_publishers(self.sub_joints.topic_name)
+        if self._writers > 1:
+            self.rejected += 1
+            self.get_logger().error(f'{self._writers} publishers on {self.sub_joints.topic_name}: measurements '
+                                    f'refused (only the simulator may write them); no command',
+                                    throttle_duration_sec=1.0)
             return
         names = tuple(msg.name)
         if names != self._names:

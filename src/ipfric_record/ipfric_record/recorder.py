@@ -30,7 +30,6 @@ from pathlib import Path
 
 from ament_index_python.packages import get_package_share_directory
 from rclpy.executors import SingleThreadedExecutor
-from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
@@ -38,6 +37,7 @@ from ipfric_core.physics.params import ConfigError
 from ipfric_core.run.scenario import load_scenario
 from ipfric_ros import topics
 from ipfric_ros.parameters import check_unknown, declare
+from ipfric_ros.rclpy_internals import SubscriptionWaiter
 from ipfric_ros.signals import node_process
 
 from .bagwriter import BagWriter, qos_dict
@@ -84,6 +84,7 @@ class Recorder(Node):
             qos = topics.latched_qos() if latched else topics.data_qos(topics.RECORD_DEPTH)
             sub = self.create_subscription(cls, name, self._writer_for(resolved), qos, raw=True)
             self.subs.append((sub, resolved))
+        self.waiter = SubscriptionWaiter(self, *(s for s, _ in self.subs))
         self.get_logger().info(f'recording {len(self.subs)} topics to {self.path}')
 
     def _log_time(self) -> int:
@@ -103,12 +104,8 @@ class Recorder(Node):
         """Write every message still queued in the subscriptions; the number taken."""
         taken = 0
         write = self.writer.write
-        for sub, name in self.subs:
-            handle, msg_type = sub.handle, sub.msg_type
-            while True:
-                got = handle.take_message(msg_type, True)
-                if got is None:
-                    break
+        for i, (_, name) in enumerate(self.subs):
+            while (got := self.waiter.take(i)) is not None:
                 write(name, self._log_time(), got[0])
                 taken += 1
         return taken
@@ -123,13 +120,9 @@ class Recorder(Node):
         """
         executor = SingleThreadedExecutor()
         executor.add_node(self)
-        ws = _rclpy.WaitSet(len(self.subs), 0, 0, 0, 0, 0, self.context.handle)
         next_turn = time.monotonic()
         while not stop:
-            ws.clear_entities()
-            for sub, _ in self.subs:
-                ws.add_subscription(sub.handle)
-            ws.wait(100_000_000)
+            self.waiter.wait(0.1)
             if self.drain():
                 time.sleep(batch)
             if time.monotonic() >= next_turn:

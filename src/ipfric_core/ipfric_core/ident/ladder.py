@@ -39,6 +39,7 @@ from .model import LADDER_EFFECTS, Model
 from .records import Record
 
 SIM_GAIN_PERCENT = 2.0
+MIN_DROP_COUNTS = 0.05   # and by at least this much RMS [counts] (rounding alone leaves 0.29 count)
 WORSE_PERCENT = 2.0
 MAX_ROUNDS = 3
 MAX_NFEV = 40
@@ -324,8 +325,12 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
             gain = 100 * (1 - math.sqrt(ev1 / ev0)) if ev0 > 0 else 0.0
             pval = block_p_value(sse0_v, pv.window_sse(m))
             why = contradictions(pe, m, name) + unresolved(m, s, name)
+            drop = math.sqrt(ev0) - math.sqrt(ev1)
             if gain <= SIM_GAIN_PERCENT:
                 why.append(f'validation error drops by {gain:.2f} % (needs > {SIM_GAIN_PERCENT:g} %)')
+            elif drop < MIN_DROP_COUNTS:
+                why.append(f'validation error drops by {drop:.3g} count (needs {MIN_DROP_COUNTS:g}: below that '
+                           f'it is the encoders\' rounding)')
             elif pval >= P_VALUE:
                 why.append(f'the drop is not significant (p = {pval:.2g} over {pv.n_windows} windows)')
             if ee1 >= ee0:

@@ -99,12 +99,18 @@ def make_windows(rec: Record, length_s: float, forced: bool = False, span: float
     for a, b in zip(edges[::2], edges[1::2]):
         k = a
         while k < b - 1 and t[b - 1] - t[k] >= 0.3 * length_s:
-            # rest to rest: the window ends at the first rest after 0.3 of its length (up to
-            # span times its length); without one, it ends at its length
-            lo = int(np.searchsorted(t, t[k] + 0.3 * length_s))
-            far = min(b, int(np.searchsorted(t, t[k] + span * length_s, side='right')))
-            r = np.flatnonzero(rest[lo:far])
-            end = lo + int(r[0]) + 1 if len(r) else min(b, int(np.searchsorted(t, t[k] + length_s, side='right')))
+            # rest to rest: with span > 1 the window ends at the first rest after 0.3 of its
+            # length (up to span times its length), else at the last rest in its second half;
+            # without one, it ends at its length
+            end = min(b, int(np.searchsorted(t, t[k] + length_s, side='right')))
+            if span > 1.0:
+                lo = int(np.searchsorted(t, t[k] + 0.3 * length_s))
+                r = np.flatnonzero(rest[lo:min(b, int(np.searchsorted(t, t[k] + span * length_s, side='right')))])
+                end = lo + int(r[0]) + 1 if len(r) else end
+            else:
+                lo = int(np.searchsorted(t, t[k] + 0.5 * length_s))
+                r = np.flatnonzero(rest[lo:end])
+                end = lo + int(r[-1]) + 1 if len(r) and end < b else end
             starts.append(k)
             stops.append(end)
             k = end - 1
@@ -119,8 +125,11 @@ def make_windows(rec: Record, length_s: float, forced: bool = False, span: float
 
 
 def cart_windows(rec: Record) -> Windows:
-    """The windows on which the cart is judged (the angle forced when a pendulum is attached)."""
-    return make_windows(rec, CART_WINDOW_S, forced=rec.theta is not None)
+    """The windows on which the cart is judged: with a pendulum attached, its angle forced and
+    the windows stretched up to REST_SPAN times to reach the next rest (a closed loop stops
+    seldom and briefly); the cart alone stops often, and its windows keep their length."""
+    pendulum = rec.theta is not None
+    return make_windows(rec, CART_WINDOW_S, forced=pendulum, span=REST_SPAN if pendulum else 1.0)
 
 
 def angle_windows(rec: Record) -> Windows:
