@@ -10,7 +10,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 BENCHMARKS = ('closed loop 2 s, Fig. 7', 'closed loop 2 s vs MuJoCo', 'limit cycle error vs scipy',
               'Figure-11 sweep, 9 runs', 'ROS lockstep loop', 'ROS realtime 1 kHz', 'analyze a',
-              'identify on EMPS')
+              'identify on EMPS', 'identify on a 2-min')
 
 
 @pytest.mark.ros

@@ -41,8 +41,8 @@ CASES = [
      'recorder: 5 is not a mapping with ros__parameters: (parameters output, scenario_file)'),
     ('unknown section', {'s.yaml': CFG + '\nsimnode: {}\n'}, RUN, 2,
      'unknown section(s) simnode; allowed: sim_node, controller_node, recorder'),
-    ('rates differ', {'s.yaml': replaced('controller_node:\n  ros__parameters:\n    sample_rate_hz: 1000.0',
-                                         'controller_node:\n  ros__parameters:\n    sample_rate_hz: 500.0')}, RUN, 2,
+    ('rates differ', {'s.yaml': replaced('    sample_rate_hz: 1000.0\n    gain_source',
+                                         '    sample_rate_hz: 500.0\n    gain_source')}, RUN, 2,
      'controller_node.ros__parameters.sample_rate_hz: 500 Hz differs from sim_node.ros__parameters.sample_rate_hz: '
      '1000 Hz'),
     ('domain -1', {'s.yaml': CFG}, RUN + ['--domain', '-1'], 2, '--domain: -1 is out of range; allowed 0..232'),
@@ -55,7 +55,9 @@ CASES = [
     ('bag is random bytes', {'b.mcap': bytes(range(256)) * 8}, ['analyze', '--no-plots', '{dir}/b.mcap'], 2,
      'not an MCAP file (it starts with'),
     ('bag is empty', {'b.mcap': b''}, ['analyze', '--no-plots', '{dir}/b.mcap'], 2, 'not an MCAP file (it is empty'),
-    ('bag is a CSV', {'b.csv': b't,x,voltage\n0,0,1\n'}, ['analyze', '--no-plots', '{dir}/b.csv'], 2,
+    ('log of one row', {'b.csv': b't,x,voltage\n0,0,1\n'}, ['analyze', '--no-plots', '{dir}/b.csv'], 2,
+     '1 samples is too short; at least 200 are needed'),
+    ('bag is text', {'b.mcap': b't,x,voltage\n0,0,1\n'}, ['analyze', '--no-plots', '{dir}/b.mcap'], 2,
      'not an MCAP file'),
 ]
 

@@ -25,9 +25,12 @@ def test_identify_on_run_bag_and_redesign(tmp_path, capsys):
     assert main(['identify', str(tmp_path / 'run'), '--out', str(tmp_path / 'ident'), '--no-plots', '--json',
                  '--export', str(tmp_path / 'identified.yaml'), '--scenario', str(rig), '--rig', str(rig)]) == 0
     r = json.loads(capsys.readouterr().out)
-    assert r['effects_added'][0] == 'coulomb'
-    assert 0.02 < r['friction']['mu_c'] < 0.0861  # truth: exponential law, mu_c 0.04287 .. mu_s 0.0861
-    assert r['error_after']['validation']['rms'] < 0.4 * r['error_before']['validation']['rms']
+    steps = [s['step'] for s in r['ladder']]
+    assert steps[:2] == ['declared', 'refit']
+    mu_c = r['identified']['friction']['mu_c']
+    assert 0.02 < mu_c < 0.0861  # truth: exponential law, mu_c 0.04287 .. mu_s 0.0861
+    assert r['ladder'][-1]['validation']['x_rms_counts'] < 3.0    # the declared law is the rig's: a few counts
+    assert not any(p['at_bound'] for p in r['ladder'][-1]['params'])
     before = load_scenario(rig)
     after = load_scenario(r['export']['on_rig'])
     assert after.friction == before.friction and after.truth == before.truth  # same rig, new gain

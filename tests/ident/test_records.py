@@ -90,7 +90,7 @@ def test_the_angle_zero_can_be_named(tmp_path):
     th = np.linspace(np.pi, 0.0, N)          # from hanging to upright, measured from upright
     (tmp_path / 'swing.csv').write_text(table(theta=th))
     assert np.allclose(load(tmp_path / 'swing.csv', None, angle_zero='upright').theta, th)
-    (tmp_path / 'hang.csv').write_text(table(theta=th + np.pi))
+    (tmp_path / 'hang.csv').write_text(table(theta=th - np.pi))     # the same, measured from hanging
     assert np.allclose(load(tmp_path / 'hang.csv', None, angle_zero='hanging').theta, th)
     with pytest.raises(ConfigError, match='angle zero'):
         load(tmp_path / 'hang.csv', None, angle_zero='sideways')

@@ -83,7 +83,7 @@ def test_a_killed_node_is_named_once_and_the_summary_agrees_with_the_bag(tmp_pat
     r.start()
     try:
         started(r.logs['sim_node'], r.procs['sim_node'])
-        mcap = tmp_path / 'run' / 'bag' / 'bag.mcap'
+        mcap = next((tmp_path / 'run' / 'bag').glob('*.mcap'))
         t0 = time.monotonic()
         while mcap.stat().st_size < 2.5e6:          # two 1 MiB chunks on disk
             assert time.monotonic() - t0 < 120, 'the recorder wrote nothing'
@@ -134,7 +134,8 @@ def test_a_rogue_flood_is_refused_counted_and_cannot_hold_the_simulator(tmp_path
 
     from ipfric_msgs.msg import VoltageCommand
     from ipfric_ros import topics
-    cfg = scenario_file(tmp_path, 'default.yaml', sim={'duration': 4.0})
+    # long enough that discovery (seconds on loopback) meets the rogue while the run goes on
+    cfg = scenario_file(tmp_path, 'default.yaml', sim={'duration': 12.0})
     r = Run(cfg, tmp_path / 'run', timeout=300)
     r.start()
     peer = None
@@ -165,7 +166,7 @@ def test_a_rogue_flood_is_refused_counted_and_cannot_hold_the_simulator(tmp_path
     bag = read_run(res.bag)
     codes = [code for _, code, _ in bag.events]
     assert 'INTRUDER' in codes
-    assert codes.count('BAD_COMMAND') <= 2 + 4 * 2   # per burst (about one a second), not per message
+    assert codes.count('BAD_COMMAND') <= 2 + 12 * 2  # per burst (about one a second), not per message
 
 
 def test_fake_measurements_from_a_second_publisher_are_refused_by_the_controller(tmp_path):
@@ -174,7 +175,7 @@ def test_fake_measurements_from_a_second_publisher_are_refused_by_the_controller
     from sensor_msgs.msg import JointState
 
     from ipfric_ros import topics
-    cfg = scenario_file(tmp_path, 'default.yaml', sim={'duration': 3.0})
+    cfg = scenario_file(tmp_path, 'default.yaml', sim={'duration': 8.0})
     r = Run(cfg, tmp_path / 'run', timeout=300)
     r.start()
     peer = None

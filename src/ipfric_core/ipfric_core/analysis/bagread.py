@@ -268,7 +268,7 @@ class _Reader:
         if op not in RECORDS:
             return
         stream = ReadDataStream(BytesIO(content))
-        rec = Message.read(stream, len(content)) if op == OP_MESSAGE else RECORDS[op].read(stream)
+        rec = Message.read(stream, len(content)) if op == OP_MESSAGE else RECORDS[op].read(stream)  # type: ignore[attr-defined]
         if isinstance(rec, Schema):
             self.schemas[rec.id] = rec
         elif isinstance(rec, Channel):
@@ -360,7 +360,7 @@ class _Reader:
             if compression:
                 return size, None, False, 'compressed chunk cut short'
             return size, memoryview(b)[start:size], False, 'cut short'
-        data = memoryview(b)[start:end]
+        data: bytes | memoryview = memoryview(b)[start:end]
         try:
             if compression == 'zstd':
                 import zstandard
@@ -412,9 +412,10 @@ class _Reader:
             length = int.from_bytes(b[pos + 1:pos + 9], 'little')
             end = pos + 9 + length
             if op == OP_CHUNK:
-                pos = self.read_chunk(pos)
-                if pos is None:
+                nxt = self.read_chunk(pos)
+                if nxt is None:
                     return 'the last chunk is cut short'
+                pos = nxt
                 if pos >= size:
                     return 'no footer: the file was not closed'
                 continue

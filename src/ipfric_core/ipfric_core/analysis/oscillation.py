@@ -128,13 +128,14 @@ def classify(t, x, theta, resolution=(CART_RESOLUTION_M, ANGLE_RESOLUTION_RAD), 
     pc, ps = crossing_period(ts, signal), spectral_period(ts, signal)
     window_span = (float(ts[0]), float(ts[-1]))
     cycles = pc is not None and len(_transitions(ts, signal)[0]) >= 3      # 1.5 cycles or more
+    period = pc or 0.0
     if second > 1.25 * first:
-        cls = 'growing' if not cycles or _regular(ts, signal, pc, ps) else 'irregular'
+        cls = 'growing' if not cycles or _regular(ts, signal, period, ps) else 'irregular'
     elif second < 0.5 * first or not cycles:
         # decaying, or a creep without 1.5 visible cycles: converging to rest
         return Oscillation('settled', None, xp, thp, None, None, None, stick, window_span)
     else:
-        cls = 'limit_cycle' if _regular(ts, signal, pc, ps) else 'irregular'
+        cls = 'limit_cycle' if _regular(ts, signal, period, ps) else 'irregular'
     onset = _onset(t, theta if use_theta else x, signal)
     agree = bool(pc and ps and abs(pc - ps) <= 0.1 * max(pc, ps))
     return Oscillation(cls, onset, xp, thp, pc, ps, 1.0 / pc if pc else None, stick, window_span, agree)

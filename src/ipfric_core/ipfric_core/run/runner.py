@@ -234,6 +234,10 @@ class Run:
             raise ConfigError(f'--timeout: {self.timeout!r} must be > 0 wall seconds')
         if self.out.exists() and not self.out.is_dir():
             raise ConfigError(f'--out: {self.out} is a file; give a directory (created if missing)')
+        if (self.out / 'bag').exists():
+            raise ConfigError(f'{self.out / "bag"} exists already; choose another --out')
+        if self.duration is not None and not (math.isfinite(self.duration) and self.duration >= 0):
+            raise ConfigError(f'--duration: {self.duration!r} must be >= 0 s')
         return write_run_scenario(self.config, self.out,
                                   None if self.duration is None else {'duration': float(self.duration)})
 
