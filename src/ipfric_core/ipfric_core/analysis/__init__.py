@@ -4,7 +4,7 @@ Modules: bagread, oscillation, plots, recorded_run, sweep. Every public name bel
 from its module on first use, so importing the package stays cheap."""
 from __future__ import annotations
 
-import importlib
+from ..lazy import lazy_getattr
 
 #: public name -> module that defines it
 _WHERE = {
@@ -57,13 +57,7 @@ _WHERE = {
     'threshold_angle': 'sweep',
     'transition_figure': 'plots',
 }
+_MODULES = ['bagread', 'oscillation', 'plots', 'recorded_run', 'sweep']
 
-__all__ = sorted(_WHERE) + ['bagread', 'oscillation', 'plots', 'recorded_run', 'sweep']
-
-
-def __getattr__(name: str):
-    if name in _WHERE:
-        return getattr(importlib.import_module(f'.{_WHERE[name]}', __name__), name)
-    if name in __all__:
-        return importlib.import_module(f'.{name}', __name__)
-    raise AttributeError(f'module {__name__!r} has no attribute {name!r}')
+__all__ = sorted(_WHERE) + _MODULES
+__getattr__ = lazy_getattr(__name__, _WHERE, _MODULES)

@@ -6,7 +6,7 @@ Every public name below is loaded from its module on first use, so importing the
 stays cheap."""
 from __future__ import annotations
 
-import importlib
+from ..lazy import lazy_getattr
 
 #: public name -> module that defines it
 _WHERE = {
@@ -52,14 +52,8 @@ _WHERE = {
     'stability_report': 'reports',
     'static_coefficient': 'estimation',
 }
+_MODULES = ['critical_delay', 'estimation', 'linearize', 'lqr', 'paper', 'paperconfig', 'reports',
+            'stability']
 
-__all__ = sorted(_WHERE) + ['critical_delay', 'estimation', 'linearize', 'lqr', 'paper', 'paperconfig', 'reports',
-                            'stability']
-
-
-def __getattr__(name: str):
-    if name in _WHERE:
-        return getattr(importlib.import_module(f'.{_WHERE[name]}', __name__), name)
-    if name in __all__:
-        return importlib.import_module(f'.{name}', __name__)
-    raise AttributeError(f'module {__name__!r} has no attribute {name!r}')
+__all__ = sorted(_WHERE) + _MODULES
+__getattr__ = lazy_getattr(__name__, _WHERE, _MODULES)

@@ -6,7 +6,7 @@ redesign, report, residual, shooting. Every public name below is loaded from its
 first use, so importing the package stays cheap."""
 from __future__ import annotations
 
-import importlib
+from ..lazy import lazy_getattr
 
 #: public name -> module that defines it
 _WHERE = {
@@ -34,6 +34,7 @@ _WHERE = {
     'MAX_ROUNDS': 'ladder',
     'MAX_ROWS': 'records',
     'MAX_VOLTAGE': 'records',
+    'MIN_DROP_COUNTS': 'ladder',
     'MIN_GAIN_PERCENT': 'equation_error',
     'MIN_SAMPLES': 'records',
     'MULTISINE': 'excitation',
@@ -154,14 +155,8 @@ _WHERE = {
     'write_ladder_report': 'ladder_report',
     'write_report': 'report',
 }
+_MODULES = ['effects', 'equation_error', 'excitation', 'ladder', 'ladder_report', 'model', 'records',
+            'redesign', 'report', 'residual', 'shooting']
 
-__all__ = sorted(_WHERE) + ['effects', 'equation_error', 'excitation', 'ladder', 'ladder_report', 'model', 'records',
-                            'redesign', 'report', 'residual', 'shooting']
-
-
-def __getattr__(name: str):
-    if name in _WHERE:
-        return getattr(importlib.import_module(f'.{_WHERE[name]}', __name__), name)
-    if name in __all__:
-        return importlib.import_module(f'.{name}', __name__)
-    raise AttributeError(f'module {__name__!r} has no attribute {name!r}')
+__all__ = sorted(_WHERE) + _MODULES
+__getattr__ = lazy_getattr(__name__, _WHERE, _MODULES)

@@ -4,7 +4,7 @@ Modules: nodes, runner, scenario. Every public name below is loaded from its mod
 use, so importing the package stays cheap."""
 from __future__ import annotations
 
-import importlib
+from ..lazy import lazy_getattr
 
 #: public name -> module that defines it
 _WHERE = {
@@ -52,13 +52,7 @@ _WHERE = {
     'sim_faults': 'runner',
     'write_run_scenario': 'nodes',
 }
+_MODULES = ['nodes', 'runner', 'scenario']
 
-__all__ = sorted(_WHERE) + ['nodes', 'runner', 'scenario']
-
-
-def __getattr__(name: str):
-    if name in _WHERE:
-        return getattr(importlib.import_module(f'.{_WHERE[name]}', __name__), name)
-    if name in __all__:
-        return importlib.import_module(f'.{name}', __name__)
-    raise AttributeError(f'module {__name__!r} has no attribute {name!r}')
+__all__ = sorted(_WHERE) + _MODULES
+__getattr__ = lazy_getattr(__name__, _WHERE, _MODULES)
