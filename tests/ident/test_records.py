@@ -94,3 +94,11 @@ def test_the_angle_zero_can_be_named(tmp_path):
     assert np.allclose(load(tmp_path / 'hang.csv', None, angle_zero='hanging').theta, th)
     with pytest.raises(ConfigError, match='angle zero'):
         load(tmp_path / 'hang.csv', None, angle_zero='sideways')
+
+
+def test_a_log_beyond_the_row_limit_is_refused_before_it_is_read(tmp_path, monkeypatch):
+    from ipfric_core.ident import records
+    monkeypatch.setattr(records, 'MAX_ROWS', 200)
+    (tmp_path / 'long.csv').write_text(table())          # 600 rows, over 1.5 times the limit
+    with pytest.raises(ConfigError, match='at most 200 are read'):
+        load(tmp_path / 'long.csv', None)

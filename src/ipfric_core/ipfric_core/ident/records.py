@@ -27,7 +27,7 @@ import numpy as np
 from ..physics.params import ConfigError, PlantParams
 
 MIN_SAMPLES = 200
-MAX_ROWS = 20_000_000   # a CSV longer than this is refused (about 1 GB of text)
+MAX_ROWS = 2_000_000    # a longer CSV is refused (33 min at 1 kHz; identification would take hours)
 MAX_VOLTAGE = 1e3       # |u| beyond this is not a drive command [V]
 OVERRUN_JUMP = 1.75     # a stamp step this many times the median period starts an overrun
 MAX_FROZEN = 5          # samples after a jump that may repeat the last reading
@@ -229,6 +229,12 @@ def load_csv(path: str | Path, plant: PlantParams, columns: dict | None = None, 
                           f'allowed: t, x, voltage, theta')
     cols.update(columns or {})
     lines = ((i, ln) for i, ln in _text_lines(path) if ln.strip() and not ln.lstrip().startswith('#'))
+    head = [ln for _, ln in zip(range(100), _text_lines(path))]
+    if path.suffix.lower() != '.gz' and head:
+        estimate = path.stat().st_size / (sum(len(ln[1]) for ln in head) / len(head))
+        if estimate > 1.5 * MAX_ROWS:
+            raise ConfigError(f'{path}: about {estimate:.3g} rows ({path.stat().st_size / 1e6:.0f} MB); at most '
+                              f'{MAX_ROWS} are read: cut or decimate the log')
     first = next(lines, None)
     if first is None:
         raise ConfigError(f'{path}: empty file; expected a header t,x,voltage[,theta]')
