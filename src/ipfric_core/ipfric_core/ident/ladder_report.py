@@ -12,7 +12,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from .ladder import TYPICAL, Problem, Step  # noqa: E402
-from .report import save_figure  # noqa: E402
+from .report import save_figure, write_report  # noqa: E402
 
 
 def param_table(step: Step) -> list[dict]:
@@ -128,11 +128,5 @@ def ladder_figures(res: dict, out: Path) -> list[str]:
 
 
 def write_ladder_report(res: dict, out: str | Path, plots: bool = True) -> dict:
-    """Write result.json, report.md and the figures into ``out``; return the result dict."""
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    r = ladder_result(res)
-    r['figures'] = ladder_figures(res, out) if plots else []
-    (out / 'result.json').write_text(json.dumps(r, indent=2, default=float))
-    (out / 'report.md').write_text(ladder_markdown(r))
-    return r
+    """Write result.json, report.md and the figures of a ladder into ``out``; the result dict."""
+    return write_report(res, out, plots, ladder_result, ladder_figures, ladder_markdown)

@@ -157,12 +157,15 @@ def markdown(r: dict) -> str:
     return '\n'.join(lines)
 
 
-def write_report(res: dict, out: str | Path, plots: bool = True) -> dict:
-    """Write result.json, report.md and the figures into ``out``; return the result dict."""
+def write_report(res: dict, out: str | Path, plots: bool = True, result=None, figs=None, text=None) -> dict:
+    """Write result.json, report.md and the figures into ``out``; return the result dict.
+
+    ``result``, ``figs``, ``text``: the functions that make the result dict, the figures and the
+    Markdown (default: this module's, an equation-error search; a ladder passes its own)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    r = result_dict(res)
-    r['figures'] = figures(res, out) if plots else []
+    r = (result or result_dict)(res)
+    r['figures'] = (figs or figures)(res, out) if plots else []
     (out / 'result.json').write_text(json.dumps(r, indent=2, default=float))
-    (out / 'report.md').write_text(markdown(r))
+    (out / 'report.md').write_text((text or markdown)(r))
     return r
