@@ -236,8 +236,10 @@ SIZE = {'deadzone': ('dz',), 'delay': ('delay',), 'cogging': ('cog_a', 'cog_b'),
 def unresolved(model: Model, std: dict, name: str) -> list[str]:
     """The effect's size is not told from zero: every size parameter within two standard errors."""
     stds = [std.get(k) for k in SIZE.get(name, ())]
-    if not stds or any(s is None or not math.isfinite(s) for s in stds):
+    if not stds:
         return []
+    if any(s is None or not math.isfinite(s) for s in stds):
+        return ['its size has no standard error (the data do not determine it)']
     sizes = [(k, model[k], float(s or 0.0)) for k, s in zip(SIZE[name], stds)]
     if all(abs(v) <= 2 * s for _, v, s in sizes):
         return ['its size is within two standard errors of zero (' +
@@ -277,7 +279,8 @@ def candidate(pe: Problem, current: Model, name: str, prior: Model) -> tuple[Mod
     costs = [pe.cost(m) for m in fits]
     best = fits[int(np.argmin(costs))]
     if min(costs) > (1 - SCREEN_GAIN) * pe.cost(current):
-        return best, {}   # explains nothing even with the levels free: not worth a full fit
+        return best, {}   # explains nothing even with the levels free: not worth a full fit (and no
+        #                   standard error, so :func:`unresolved` refuses it)
     joint = own | ({p.name for p in current.free} & {'Fc', 'Fs_excess', 'eps'})
     return fit_model(pe, best, only=joint, prior=prior)
 
