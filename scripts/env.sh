@@ -28,7 +28,7 @@ unset ROS_STATIC_PEERS ROS_LOCALHOST_ONLY ROS_DISCOVERY_SERVER ROS_SUPER_CLIENT 
 export RMW_IMPLEMENTATION=rmw_fastrtps_cpp
 
 # ---- numerics: one BLAS thread, so that a fit takes the same path on every run (sums in one order)
-export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 MKL_NUM_THREADS=1
+export OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1
 
 # ---- Python: the project's venv
 if [ ! -x "$_ipfric_venv/bin/python" ]; then
