@@ -520,6 +520,123 @@ def cmd_bench(args) -> int:
     return 0
 
 
+ORBIT_PARAMETERS = ('delay', 'gain', 'friction')
+
+
+def _orbit_loop(base, name: str, value: float):
+    """The sampled loop of scenario ``base`` at continuation parameter ``name`` = ``value``."""
+    from dataclasses import replace
+
+    from .design.orbit import loop_numbers
+    scn, delay = base, None
+    if name == 'delay':
+        delay = value
+    elif name == 'gain':
+        scn = replace(base, controller=replace(base.controller, gain=tuple(value * k for k in base.gain())))
+    else:
+        f = base.friction
+        scn = replace(base, friction=f.replace(mu_s=value * f.mu_s, mu_c=value * f.mu_c, eps=value * f.eps))
+    return loop_numbers(scn.make_rig().loop_spec(), scn.make_controller().loop_spec(), delay)
+
+
+def _simulated_cycle(scn, duration: float) -> dict:
+    """Amplitude and mean period of the last half of a long offline run (true states)."""
+    import numpy as np
+
+    from .physics.closedloop import run_closed_loop
+    tr = run_closed_loop(scn.make_rig(), scn.make_controller(), duration)
+    half = len(tr.t) // 2
+    th = tr.state[half:, 1]
+    lvl = 0.5 * (th.max() + th.min())
+    up = np.flatnonzero((th[:-1] < lvl) & (th[1:] >= lvl))
+    period = float((up[-1] - up[0]) / (len(up) - 1) * scn.sample_period) if len(up) > 1 else math.nan
+    return {'x_p2p_m': float(np.ptp(tr.state[half:, 0])), 'theta_p2p_rad': float(np.ptp(th)), 'period_s': period,
+            'end_reason': tr.end_reason, 'duration_s': duration}
+
+
+def cmd_orbit(args) -> int:
+    base = _sweep_base(args.config, args.sensors, args.smoothing, args.cutoff_hz)
+    from .design.continuation import parse_continuation
+    cont = None
+    if args.continue_:
+        try:
+            cont = parse_continuation(args.continue_)
+        except ValueError as exc:
+            raise ConfigError(str(exc)) from None
+        if cont[0] not in ORBIT_PARAMETERS:
+            raise ConfigError(f'--continue {cont[0]!r}: unknown parameter; allowed: {", ".join(ORBIT_PARAMETERS)} '
+                              '(delay [s]; gain and friction as multiples of the scenario\'s)')
+        if cont[0] == 'delay' and min(cont[1]) < 0:
+            raise ConfigError('--continue delay: delays must be >= 0 s')
+    import time
+
+    from .design.continuation import trace, unstable_partners
+    from .design.orbit import OrbitError, find_orbit
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    loop = _orbit_loop(base, 'delay', base.controller.delay)
+    try:
+        main_orbit = find_orbit(loop)
+        orbits = [main_orbit] + unstable_partners(loop, main_orbit)
+    except OrbitError as exc:
+        orbits, why = [], str(exc)
+    took = time.perf_counter() - t0
+    res: dict = {'config': args.config, 'sensors': args.sensors, 'delay_s': base.controller.delay,
+                 'orbits': [o.summary() for o in orbits], 'seconds': round(took, 3)}
+    if not orbits:
+        res['no_orbit'] = why
+    if args.simulate > 0:
+        res['simulation'] = _simulated_cycle(base, args.simulate)
+    if cont:
+        name, values = cont
+
+        def progress(done, total):
+            print(f'\r[orbit] {name} {done}/{total}', end='' if done < total else '\n', file=sys.stderr, flush=True)
+
+        t0 = time.perf_counter()
+        points, events = trace(lambda v: _orbit_loop(base, name, v), values,
+                               progress=None if args.json else progress)
+        res['continuation'] = {'parameter': name, 'values': len(values), 'points': len(points), 'events': events,
+                               'seconds': round(time.perf_counter() - t0, 2)}
+        import csv
+        rows = [p.row() for p in points]
+        with open(out / 'branches.csv', 'w', newline='') as fh:
+            wr = csv.DictWriter(fh, fieldnames=list(rows[0]) if rows else ['parameter'])
+            wr.writeheader()
+            wr.writerows(rows)
+        if not args.no_plots:
+            from .analysis.bifurcation import diagram
+            res['continuation']['plot'] = str(diagram(base, name, values, rows, events, out / 'bifurcation.png',
+                                                      args.describing))
+    (out / 'orbit.json').write_text(json.dumps(res, indent=2, default=float))
+    if args.json:
+        _print_json(res)
+        return 0
+    print(f'Periodic orbits of {args.config} ({args.sensors} sensors, delay {base.controller.delay:g} s), '
+          f'{took:.2f} s')
+    if not orbits:
+        print(f'  none: {why}')
+    for o in orbits:
+        m = abs(o.multipliers[0]) if len(o.multipliers) else 0.0
+        print(f'  {"stable  " if o.stable else "unstable"} x p2p {100 * o.x_p2p:.4f} cm, theta p2p '
+              f'{o.theta_p2p:.3e} rad, period {o.period:.5f} s, stuck {100 * o.stuck_fraction:.1f} % '
+              f'({o.sticks} sticking phases), largest multiplier |{m:.3g}|')
+    if 'simulation' in res:
+        s = res['simulation']
+        print(f'  simulation ({args.simulate:g} s, last half): x p2p {100 * s["x_p2p_m"]:.4f} cm, '
+              f'period {s["period_s"]:.5f} s ({s["end_reason"]})')
+    if cont:
+        c = res['continuation']
+        print(f'  continuation in {c["parameter"]}: {c["points"]} orbits at {c["values"]} values, '
+              f'{c["seconds"]} s; events: ' + (', '.join(f'{e["event"]} of branch {e["branch"]} at '
+                                                        f'{e["parameter"]:.4g}' for e in c['events']) or 'none'))
+        if 'plot' in c:
+            print(f'  diagram: {c["plot"]}')
+    print(f'  written: {out / "orbit.json"}')
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog='ipfric', description='Friction and the inverted pendulum: '
                                 'design, simulation, ROS 2 closed loop and analysis.')
@@ -625,6 +742,27 @@ def build_parser() -> argparse.ArgumentParser:
     i.add_argument('--loop', metavar='SCENARIO', help='closed-loop redesign offline: run SCENARIO, identify on '
                    'its measured data, redesign, run again; prints the amplitudes before and after')
     i.add_argument('--duration', type=float, default=20.0, help='--loop: simulated seconds per run '
+                   '(default %(default)s)')
+    o = add('orbit', cmd_orbit, 'periodic orbits of the sampled closed loop found directly (shooting on a '
+            'Poincare section, Newton, Floquet multipliers), stable and unstable; --continue traces them over '
+            'the delay, a gain scale or a friction scale (bifurcation diagram)')
+    o.add_argument('--config', default=str(REPO_ROOT / 'config' / 'default.yaml'),
+                   help='scenario (default %(default)s)')
+    o.add_argument('--sensors', choices=('exact', 'config'), default='exact',
+                   help='exact states as in the paper\'s simulations, or the scenario\'s encoders '
+                   '(default %(default)s)')
+    o.add_argument('--smoothing', choices=('none', 'tanh'), default=None, help='override the friction smoothing')
+    o.add_argument('--cutoff-hz', type=float, default=None,
+                   help='override the controller\'s velocity filter corner [Hz] (0 = raw difference)')
+    o.add_argument('--continue', dest='continue_', metavar='NAME=START:STOP[:COUNT]',
+                   help='trace the orbits over delay [s], gain or friction (multiples of the scenario\'s '
+                   'gain, or of its mu_s, mu_c and eps), e.g. delay=0:0.14:141')
+    o.add_argument('--simulate', type=float, default=120.0,
+                   help='also run the loop this many seconds and report its cycle beside the orbit (0 = no)')
+    o.add_argument('--describing', action='store_true',
+                   help='with --continue: draw the describing-function prediction on the diagram')
+    o.add_argument('--no-plots', action='store_true', help='numbers only')
+    o.add_argument('--out', default='runs/orbit', help='directory for orbit.json, branches.csv, bifurcation.png '
                    '(default %(default)s)')
     b = add('bench', cmd_bench, 'benchmarks beside their references (scipy, MuJoCo, raw rclpy): offline closed '
             'loop, Figure-11 sweep, ROS lockstep and realtime loops, analyze, identify; table and bench/RESULTS.md')
