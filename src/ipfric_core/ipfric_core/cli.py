@@ -539,21 +539,6 @@ def _orbit_loop(base, name: str, value: float):
     return loop_numbers(scn.make_rig().loop_spec(), scn.make_controller().loop_spec(), delay)
 
 
-def _simulated_cycle(scn, duration: float) -> dict:
-    """Amplitude and mean period of the last half of a long offline run (true states)."""
-    import numpy as np
-
-    from .physics.closedloop import run_closed_loop
-    tr = run_closed_loop(scn.make_rig(), scn.make_controller(), duration)
-    half = len(tr.t) // 2
-    th = tr.state[half:, 1]
-    lvl = 0.5 * (th.max() + th.min())
-    up = np.flatnonzero((th[:-1] < lvl) & (th[1:] >= lvl))
-    period = float((up[-1] - up[0]) / (len(up) - 1) * scn.sample_period) if len(up) > 1 else math.nan
-    return {'x_p2p_m': float(np.ptp(tr.state[half:, 0])), 'theta_p2p_rad': float(np.ptp(th)), 'period_s': period,
-            'end_reason': tr.end_reason, 'duration_s': duration}
-
-
 def cmd_orbit(args) -> int:
     base = _sweep_base(args.config, args.sensors, args.smoothing, args.cutoff_hz)
     from .design.continuation import parse_continuation
@@ -587,7 +572,8 @@ def cmd_orbit(args) -> int:
     if not orbits:
         res['no_orbit'] = why
     if args.simulate > 0:
-        res['simulation'] = _simulated_cycle(base, args.simulate)
+        from .design.orbit import simulated_cycle
+        res['simulation'] = simulated_cycle(base.make_rig(), base.make_controller(), args.simulate)
     if cont:
         name, values = cont
 

@@ -40,6 +40,7 @@ from ..physics.closedloop import (
     loop_start,
     plant_segment,
 )
+from ..physics.closedloop import run_closed_loop
 from ..physics.compiled import compiled
 from ..physics.friction import DYNAMIC, FP_MODEL
 
@@ -394,3 +395,16 @@ def resized(z: np.ndarray, delay_from: int, delay_to: int) -> np.ndarray:
     else:
         rows = rows[delay_from - delay_to:]
     return np.concatenate([z[:LS_HISTORY], rows.ravel(), z[LS_HISTORY + 4 * delay_from:]])
+
+
+def simulated_cycle(rig, controller, duration: float) -> dict:
+    """What a plain run does: cart and angle peak-to-peak over its last half (true states) and
+    the mean period between rises of theta through the middle of its swing [s]."""
+    tr = run_closed_loop(rig, controller, duration)
+    half = len(tr.t) // 2
+    th = tr.state[half:, 1]
+    lvl = 0.5 * (th.max() + th.min())
+    up = np.flatnonzero((th[:-1] < lvl) & (th[1:] >= lvl))
+    period = float((up[-1] - up[0]) / (len(up) - 1) * rig.dt) if len(up) > 1 else math.nan
+    return {'x_p2p_m': float(np.ptp(tr.state[half:, 0])), 'theta_p2p_rad': float(np.ptp(th)), 'period_s': period,
+            'end_reason': tr.end_reason, 'duration_s': duration}
