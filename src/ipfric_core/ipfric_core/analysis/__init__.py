@@ -1,6 +1,6 @@
 """Recorded runs analysed offline: the MCAP reader, oscillation classes, sweeps, plots.
 
-Modules: bagread, oscillation, plots, recorded_run, sweep. Every public name below is loaded
+Modules: bagread, bifurcation, oscillation, plots, recorded_run, sweep. Every public name below is loaded
 from its module on first use, so importing the package stays cheap."""
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from ..lazy import lazy_getattr
 _WHERE = {
     'ABSURD': 'bagread',
     'CLASSES': 'oscillation',
-    'CLASS_COLOURS': 'plots',
+    'CLASS_COLOURS': 'bifurcation',
     'COMPRESSIONS': 'bagread',
     'DECODED': 'bagread',
     'FIELDS': 'sweep',
@@ -36,7 +36,9 @@ _WHERE = {
     'classify_samples': 'sweep',
     'count_size': 'recorded_run',
     'crossing_period': 'oscillation',
+    'diagram': 'bifurcation',
     'grid': 'sweep',
+    'linear_critical_delay': 'bifurcation',
     'load_cells': 'sweep',
     'loop_timing': 'recorded_run',
     'mcap_file': 'bagread',
@@ -52,12 +54,13 @@ _WHERE = {
     'run_cell': 'sweep',
     'run_figure': 'plots',
     'run_name': 'recorded_run',
+    'simulated_classes': 'bifurcation',
     'spectral_period': 'oscillation',
     'stability_map': 'plots',
     'threshold_angle': 'sweep',
     'transition_figure': 'plots',
 }
-_MODULES = ['bagread', 'oscillation', 'plots', 'recorded_run', 'sweep']
+_MODULES = ['bagread', 'bifurcation', 'oscillation', 'plots', 'recorded_run', 'sweep']
 
 __all__ = sorted(_WHERE) + _MODULES
 __getattr__ = lazy_getattr(__name__, _WHERE, _MODULES)

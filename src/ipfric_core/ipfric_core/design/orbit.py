@@ -39,8 +39,8 @@ from ..physics.closedloop import (
     drive_command,
     loop_start,
     plant_segment,
+    run_closed_loop,
 )
-from ..physics.closedloop import run_closed_loop
 from ..physics.compiled import compiled
 from ..physics.friction import DYNAMIC, FP_MODEL
 
