@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from .design.paperconfig import DEFAULT_CONFIG, DEFAULT_DATA, REPO_ROOT, load_paper_config
+from .executor import SchedulerError
 from .ident.records import ANGLE_ZEROS
 from .physics.params import ConfigError
 
@@ -255,7 +256,8 @@ def _figure_sweep(args, taus, progress) -> dict:
             d = out / f'{gname}_{smoothing or "model"}'
             if progress:
                 print(f'[sweep] {label}, {gname} grid -> {d}', file=sys.stderr)
-            rows = sweep(base, taus, ths, args.duration, d, args.workers, progress, ros=args.ros)
+            rows = sweep(base, taus, ths, args.duration, d, args.workers, progress, ros=args.ros,
+                         scheduler=args.scheduler)
             b = boundaries(rows, taus, ths)
             panel.setdefault('classes', grid(rows, taus, ths))
             panel['curves'].append((label, style, ths, [r['first_unsettled_tau_s'] for r in b],
@@ -277,7 +279,7 @@ def _resolution_sweep(args, out: Path) -> int:
     if (scales < 0).any():
         raise ConfigError('--resolution-scale: scales must be >= 0 (0 = exact sensors, 1 = the scenario\'s)')
     base = _sweep_base(args.config, 'config', args.smoothing, args.cutoff_hz)
-    rows = resolution_study(base, scales, args.duration, args.scale_sensor, args.workers)
+    rows = resolution_study(base, scales, args.duration, args.scale_sensor, args.workers, args.scheduler)
     out.mkdir(parents=True, exist_ok=True)
     fig = resolution_figure(rows, f'{Path(args.config).stem}: oscillation against {args.scale_sensor} '
                             'encoder resolution',
@@ -309,7 +311,8 @@ def _threshold(args, out: Path) -> int:
     def progress(a, b):
         print(f'[threshold] settles from {a:.4g} rad, cycles from {b:.4g} rad', file=sys.stderr)
     try:
-        res = threshold_angle(base, lo, hi, args.duration, progress=None if args.json else progress)
+        res = threshold_angle(base, lo, hi, args.duration, progress=None if args.json else progress,
+                              scheduler=args.scheduler)
     except ValueError as exc:
         raise ConfigError(f'--threshold: {exc}') from exc
     res.update(config=args.config, sensors=args.sensors, cutoff_hz=base.controller.cutoff_hz,
@@ -335,6 +338,9 @@ def cmd_sweep(args) -> int:
         raise ConfigError(f'--tau/--theta0-deg: {exc}') from exc
     progress = None if args.json else print_progress
     out = Path(args.out)
+    if args.ros and args.scheduler:
+        raise ConfigError('--ros with --scheduler: a ROS cell runs three node processes on this machine; '
+                          'drop one of them')
     if args.figure:
         summary = _figure_sweep(args, taus, progress)
         (out / 'summary.json').write_text(json.dumps(summary, indent=2, default=float))
@@ -354,7 +360,8 @@ def cmd_sweep(args) -> int:
     if args.threshold:
         return _threshold(args, out)
     base = _sweep_base(args.config, args.sensors, args.smoothing, args.cutoff_hz)
-    rows = sweep(base, taus, ths, args.duration, out, args.workers, progress, ros=args.ros)
+    rows = sweep(base, taus, ths, args.duration, out, args.workers, progress, ros=args.ros,
+                 scheduler=args.scheduler)
     title = f'{Path(args.config).stem}: {base.friction.model}' + (
         f', tanh({base.friction.delta:g} v)' if base.friction.smoothing == 'tanh' else '')
     fig = stability_map(taus, ths, grid(rows, taus, ths), title, out / 'map.png')
@@ -577,7 +584,11 @@ def build_parser() -> argparse.ArgumentParser:
                    '(default %(default)s)')
     w.add_argument('--smoothing', choices=('none', 'tanh'), default=None, help='override the friction smoothing')
     w.add_argument('--workers', type=int, default=None,
-                   help='parallel cells (default: all cores offline, 1 with --ros)')
+                   help='parallel cells in local processes (default: all cores offline, 1 with --ros)')
+    w.add_argument('--scheduler', default=None, metavar='ADDRESS',
+                   help='run the cells on the Dask cluster whose scheduler listens at ADDRESS '
+                        '(e.g. tcp://10.0.0.5:8786; its workers run this project\'s environment), same rows '
+                        'as the local processes')
     w.add_argument('--ros', action='store_true',
                    help='run each cell through the ROS 2 nodes in lockstep (bags kept in OUT/ros)')
     w.add_argument('--figure', choices=sorted(FIGURES), default=None,
@@ -642,6 +653,9 @@ def main(argv=None) -> int:
         return args.func(args)
     except ConfigError as exc:
         print(f'ipfric {args.command}: configuration error: {exc}', file=sys.stderr)
+        return 2
+    except SchedulerError as exc:
+        print(f'ipfric {args.command}: {exc}', file=sys.stderr)
         return 2
 
 
