@@ -1,15 +1,17 @@
 """Design on the physics (paper sections 3-5): linearization, LQR, Routh-Hurwitz, the critical
-delay, friction estimates from the appendix tables, the printed numbers.
+delay, the describing-function prediction of the hunting, friction estimates from the appendix
+tables, the printed numbers.
 
-Modules: critical_delay, estimation, linearize, lqr, paper, paperconfig, reports, stability.
-Every public name below is loaded from its module on first use, so importing the package
-stays cheap."""
+Modules: critical_delay, describing, estimation, linearize, lqr, paper, paperconfig, reports,
+stability. Every public name below is loaded from its module on first use, so importing the
+package stays cheap."""
 from __future__ import annotations
 
 from ..lazy import lazy_getattr
 
 #: public name -> module that defines it
 _WHERE = {
+    'AMPLITUDE_RANGE': 'describing',
     'BREAKAWAY_MEAN_V': 'paper',
     'CONTROL_WEIGHT': 'lqr',
     'DEFAULT_CONFIG': 'paperconfig',
@@ -20,11 +22,13 @@ _WHERE = {
     'EIG_DYNAMIC_GAIN_15': 'paper',
     'EIG_DYNAMIC_GAIN_25': 'paper',
     'EPS': 'paper',
+    'FrictionNonlinearity': 'describing',
     'GAIN_15_VISCOUS': 'paper',
     'GAIN_23_EXPONENTIAL': 'paper',
     'GAIN_25_DYNAMIC': 'paper',
     'MU_C': 'paper',
     'MU_S': 'paper',
+    'OMEGA_RANGE': 'describing',
     'PaperConfig': 'paperconfig',
     'REDUCED_GAIN_DYNAMIC': 'paper',
     'REPO_ROOT': 'paperconfig',
@@ -41,19 +45,25 @@ _WHERE = {
     'design': 'lqr',
     'design_report': 'reports',
     'friction_estimates': 'reports',
+    'friction_loop': 'describing',
+    'friction_to_state': 'describing',
+    'harmonic_balance': 'describing',
+    'hunting_over_delays': 'describing',
+    'hunting_over_gain_scales': 'describing',
     'jacobian': 'linearize',
     'load_paper_config': 'paperconfig',
     'load_table5': 'estimation',
     'load_table6': 'estimation',
     'lqr_gain': 'lqr',
+    'predict_hunting': 'describing',
     'rhp_root_count': 'stability',
     'routh_first_column': 'stability',
     'smooth_friction': 'linearize',
     'stability_report': 'reports',
     'static_coefficient': 'estimation',
 }
-_MODULES = ['critical_delay', 'estimation', 'linearize', 'lqr', 'paper', 'paperconfig', 'reports',
-            'stability']
+_MODULES = ['critical_delay', 'describing', 'estimation', 'linearize', 'lqr', 'paper', 'paperconfig',
+            'reports', 'stability']
 
 __all__ = sorted(_WHERE) + _MODULES
 __getattr__ = lazy_getattr(__name__, _WHERE, _MODULES)
