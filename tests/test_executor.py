@@ -6,6 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ipfric_core.analysis.montecarlo import run_montecarlo, spread_draw
 from ipfric_core.analysis.sweep import sweep
 from ipfric_core.cli import main
 from ipfric_core.executor import SchedulerError, make_executor
@@ -36,6 +37,17 @@ def test_sweep_on_the_cluster_gives_the_local_rows(cluster, fig9_exact, tmp_path
     assert remote == local
     assert (tmp_path / 'dask' / 'cells.csv').read_text() == (tmp_path / 'local' / 'cells.csv').read_text()
     assert {r['class'] for r in local} >= {'settled', 'fallen'}
+
+
+def test_montecarlo_on_the_cluster_gives_the_local_rows(cluster, tmp_path):
+    base = load_scenario(ROOT / 'config' / 'default.yaml')
+
+    def draw(i):
+        return spread_draw(base, {'mu_s': 0.3, 'mu_c': 0.3, 'eps': 0.3}, 11, i)
+    local = run_montecarlo(draw, 30, 5.0, workers=2)
+    remote = run_montecarlo(draw, 30, 5.0, scheduler=cluster)
+    assert remote == local
+    assert len({r['x_p2p_m'] for r in local}) > 10          # the draws differ, and so do the runs
 
 
 def free_port() -> int:

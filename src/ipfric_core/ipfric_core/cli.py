@@ -382,6 +382,56 @@ def cmd_sweep(args) -> int:
     return 0
 
 
+def cmd_montecarlo(args) -> int:
+    """The hunting's distribution over N runs with parameters drawn from --spread or --from-ident."""
+    from functools import partial
+    if args.runs < 1:
+        raise ConfigError(f'--runs: {args.runs} must be >= 1')
+    if not (math.isfinite(args.duration) and args.duration > 0):
+        raise ConfigError(f'--duration: {args.duration!r} must be > 0 s')
+    if (args.spread is None) == (args.from_ident is None):
+        raise ConfigError('give either --spread NAME=S,... (relative spreads) or --from-ident DIR (an '
+                          'identification\'s parameter table)')
+    if args.workers is not None and args.workers < 1:
+        raise ConfigError(f'--workers: {args.workers} must be >= 1')
+    base = _sweep_base(args.config, args.sensors, None)
+    from .analysis.montecarlo import parse_spread, run_montecarlo, spread_draw, write_results
+    from .analysis.sweep import print_progress
+    info: dict = {'config': args.config, 'runs': args.runs, 'duration_s': args.duration, 'seed': args.seed,
+                  'sensors': args.sensors}
+    if args.spread is not None:
+        spread = parse_spread(args.spread)
+        draw = partial(spread_draw, base, spread, args.seed, distribution=args.distribution)
+        info['drawn'] = {'spread': spread, 'distribution': args.distribution,
+                         'meaning': 'value = nominal * (1 + s z), z ~ N(0, 1)' if args.distribution == 'normal'
+                         else 'value = nominal * (1 + s u), u ~ U(-1, 1)'}
+    else:
+        from .ident.uncertainty import load_report, report_draw
+        model, std, dt = load_report(args.from_ident)
+        draw = partial(report_draw, model, std, dt, base, args.seed)
+        info['drawn'] = {'from_ident': args.from_ident, 'std': std,
+                         'meaning': 'value ~ N(identified value, std^2), independent, clipped to the bounds'}
+    rows = run_montecarlo(draw, args.runs, args.duration, args.workers, args.scheduler,
+                      None if args.json else partial(print_progress, label='runs'))
+    title = f'{Path(args.config).stem}: {args.runs} runs of {args.duration:g} s, ' + (
+        f'spread {args.spread} ({args.distribution})' if args.spread else f'from {args.from_ident}')
+    summary = write_results(rows, info, args.out, title)
+    if args.json:
+        _print_json(summary)
+        return 0
+    print(f'{args.runs} runs: ' + ', '.join(f'{c} {100 * f:.1f} %' for c, f in summary['fraction'].items() if f))
+    for key, label, scale, unit in (('true_x_p2p_m', 'cart p2p', 100.0, 'cm'),
+                                    ('true_theta_p2p_rad', 'angle p2p', 180.0 / math.pi, 'deg'),
+                                    ('period_s', 'period', 1.0, 's')):
+        q = summary[key]
+        if q:
+            print(f'  {label:<10} 5/25/50/75/95 %: ' + ' / '.join(f'{scale * q[k]:.3g}' for k in
+                                                                  ('q05', 'q25', 'q50', 'q75', 'q95'))
+                  + f' {unit} ({q["runs"]} hunting runs)')
+    print(f'summary: {Path(args.out) / "summary.json"}\nruns: {summary["csv"]}\nfigure: {summary["figure"]}')
+    return 0
+
+
 def cmd_identify(args) -> int:
     """Identification on measured data, the paper tables, or the closed-loop redesign."""
     from .ident.effects import EFFECTS
@@ -606,6 +656,30 @@ def build_parser() -> argparse.ArgumentParser:
     w.add_argument('--cutoff-hz', type=float, default=None,
                    help='override the controller\'s velocity filter corner [Hz] (0 = raw difference)')
     w.add_argument('--out', required=True, help='directory for cells.csv, map.png, summary.json')
+    mc = add('montecarlo', cmd_montecarlo, 'distribution of the hunting (cart and angle peak-to-peak, period, '
+             'class) over N runs of a scenario with its parameters drawn at random: relative spreads, or an '
+             'identification\'s parameter table with its standard errors; runs.csv, summary.json, histogram.png')
+    mc.add_argument('--config', default=str(REPO_ROOT / 'config' / 'default.yaml'),
+                    help='scenario whose parameters are drawn (default %(default)s)')
+    mc.add_argument('--runs', type=int, default=1000, help='number of runs (default %(default)s)')
+    mc.add_argument('--duration', type=float, default=20.0, help='simulated seconds per run (default %(default)s)')
+    mc.add_argument('--spread', metavar='NAME=S,...',
+                    help='relative 1-sigma spreads of plant or friction coefficients, e.g. mu_s=0.3,mu_c=0.3,eps=0.3 '
+                         '(30 %%); each value = nominal * (1 + S z), clipped to its range, mu_c <= mu_s')
+    mc.add_argument('--distribution', choices=('normal', 'uniform'), default='normal',
+                    help='--spread: z ~ N(0, 1) (S is one sigma) or z ~ U(-1, 1) (S is the half width) '
+                         '(default %(default)s)')
+    mc.add_argument('--from-ident', metavar='DIR',
+                    help='draw the fitted parameters of the final model of `./ipfric identify --out DIR` from '
+                         'N(value, std^2), independently (the report has standard errors, no covariance)')
+    mc.add_argument('--seed', type=int, default=0, help='seed; run i draws with the seed (seed, i) '
+                    '(default %(default)s)')
+    mc.add_argument('--sensors', choices=('exact', 'config'), default='config',
+                    help='the scenario\'s encoders, or exact states (default %(default)s)')
+    mc.add_argument('--workers', type=int, default=None, help='local processes (default: all cores)')
+    mc.add_argument('--scheduler', default=None, metavar='ADDRESS',
+                    help='run on the Dask cluster whose scheduler listens at ADDRESS (same rows as locally)')
+    mc.add_argument('--out', required=True, help='directory for runs.csv, summary.json, histogram.png')
     i = add('identify', cmd_identify, 'identify the cart\'s friction and undeclared effects from measured '
             'data (run bag, CSV, EMPS .mat, or "paper" for Tables 5-6): base fit, residual analysis, '
             'greedy effect search kept only when it pays on validation data; report, export, redesign')

@@ -46,6 +46,13 @@ def classify_run(scn: Scenario, duration: float, window: float = 10.0):
                             window), tr
 
 
+def true_p2p(o, tr) -> tuple[float, float]:
+    """Peak-to-peak of the true cart position [m] and angle [rad] of the Trajectory ``tr`` over the
+    window its Oscillation ``o`` was judged on (the measured ones are in encoder counts)."""
+    w = tr.t >= tr.t[-1] - o.window[1] + o.window[0]
+    return float(np.ptp(tr.state[w, 0])), float(np.ptp(tr.state[w, 1]))
+
+
 def run_cell(base: Scenario, tau: float, theta0_deg: float, duration: float,
              ros_dir: str | Path | None = None) -> dict:
     """Run and classify one cell; returns a CSV row.
@@ -185,8 +192,8 @@ def parse_range(text: str) -> np.ndarray:
                          f'or a comma-separated list of numbers') from exc
 
 
-def print_progress(done: int, total: int) -> None:
-    sys.stderr.write(f'\r[sweep] {done}/{total} cells')
+def print_progress(done: int, total: int, label: str = 'cells') -> None:
+    sys.stderr.write(f'\r[sweep] {done}/{total} {label}')
     if done == total:
         sys.stderr.write('\n')
     sys.stderr.flush()
@@ -202,11 +209,11 @@ def resolution_cell(base: Scenario, scale: float, duration: float, sensor: str =
         s, cart_resolution=s.cart_resolution * (scale if sensor in ('cart', 'both') else 1.0),
         angle_resolution=s.angle_resolution * (scale if sensor in ('angle', 'both') else 1.0)))
     o, tr = classify_run(scn, duration)
-    w = tr.t >= tr.t[-1] - o.window[1] + o.window[0]      # the true motion over the same window
+    true_x, true_theta = true_p2p(o, tr)
     return {'scale': float(scale), 'cart_resolution_m': scn.sim.cart_resolution,
             'angle_resolution_rad': scn.sim.angle_resolution, 'class': o.cls,
             'x_p2p_m': o.x_p2p, 'theta_p2p_rad': o.theta_p2p, 'period_s': o.period_crossings,
-            'true_x_p2p_m': float(np.ptp(tr.state[w, 0])), 'true_theta_p2p_rad': float(np.ptp(tr.state[w, 1]))}
+            'true_x_p2p_m': true_x, 'true_theta_p2p_rad': true_theta}
 
 
 def resolution_study(base: Scenario, scales, duration: float, sensor: str = 'angle',
