@@ -16,15 +16,16 @@ import subprocess
 import sys
 import tempfile
 import time
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
+from ipfric_core.analysis.montecarlo import parse_spread, run_chunk, run_montecarlo, spread_draw
 from ipfric_core.analysis.oscillation import classify, crossing_period
 from ipfric_core.analysis.sweep import cell_scenario, parse_range, sweep
 from ipfric_core.design.paperconfig import REPO_ROOT
+from ipfric_core.executor import make_executor
 from ipfric_core.physics.closedloop import run_closed_loop
 from ipfric_core.run.scenario import load_scenario
 
@@ -145,7 +146,7 @@ def bench_sweep(quick: bool) -> list[dict]:
     with tempfile.TemporaryDirectory() as tmp:
         t_ipf, rows = timed(lambda: sweep(base, taus, ths, duration, tmp, workers=2))
     cells = [(base, float(t), float(th), duration) for th in ths for t in taus]
-    with ProcessPoolExecutor(max_workers=2) as pool:
+    with make_executor(None, 2) as pool:
         t_mj, classes = timed(lambda: list(pool.map(_mujoco_cell, cells, chunksize=max(1, len(cells) // 8))))
     agree = np.mean([r['class'] == c for r, c in zip(rows, classes)])
     ok = t_ipf < 10.0 and t_ipf < t_mj
@@ -153,6 +154,26 @@ def bench_sweep(quick: bool) -> list[dict]:
              'reference': f'MuJoCo {t_mj:.3g} s (same class in {100 * agree:.0f} % of cells)',
              'ipfric': f'{t_ipf:.3g} s', 'ratio': t_mj / t_ipf, 'target': '< 10 s and faster than MuJoCo',
              'met': ok}]
+
+
+# ------------------------------------------------------------------------------ Monte Carlo
+def bench_montecarlo(quick: bool) -> list[dict]:
+    """./ipfric montecarlo's runs (Figure 7, friction levels and eps +/- 30 %, encoders) in 2 local
+    processes, beside the same runs one after the other in this process."""
+    base = load_scenario(CONFIG / 'fig7_old_gain_exponential.yaml')
+    runs, duration = (10, 2.0) if quick else (1000, 20.0)
+    spread = parse_spread('mu_s=0.3,mu_c=0.3,eps=0.3')
+
+    def draw(i):
+        return spread_draw(base, spread, 0, i)
+    t_ipf, rows = timed(lambda: run_montecarlo(draw, runs, duration, workers=2))
+    run_closed_loop(base.make_rig(), base.make_controller(), 0.01)  # compile / load the cache here too
+    t_one, serial = timed(lambda: run_chunk([(i, *draw(i)) for i in range(runs)], duration))
+    same = rows == serial
+    return [{'benchmark': f'Monte Carlo, {runs} runs of {duration:g} s (Fig. 7, +/- 30 % friction), 2 processes',
+             'reference': f'same runs in 1 process {t_one:.3g} s (same rows: {"yes" if same else "NO"})',
+             'ipfric': f'{t_ipf:.3g} s', 'ratio': t_one / t_ipf, 'target': '< 15 s, rows as in 1 process',
+             'met': t_ipf < 15.0 and same}]
 
 
 # -------------------------------------------------------------------------------------- ROS
@@ -284,7 +305,8 @@ def run_all(quick: bool = False, realtime_s: float = 600.0, results: Path | None
     rows = []
     work = REPO_ROOT / 'runs' / ('bench-quick' if quick else 'bench') / 'work'  # the ROS runs, kept
     shutil.rmtree(work, ignore_errors=True)
-    for name, fn in (('closed loop', lambda: bench_closed_loop(quick)), ('sweep', lambda: bench_sweep(quick))):
+    for name, fn in (('closed loop', lambda: bench_closed_loop(quick)), ('sweep', lambda: bench_sweep(quick)),
+                     ('Monte Carlo', lambda: bench_montecarlo(quick))):
         progress(f'[bench] {name} ...')
         rows += fn()
     progress('[bench] ROS lockstep, rclpy round trip, realtime ...')

@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from .design.paperconfig import DEFAULT_CONFIG, DEFAULT_DATA, REPO_ROOT, load_paper_config
+from .executor import SchedulerError
 from .ident.records import ANGLE_ZEROS
 from .physics.params import ConfigError
 
@@ -255,7 +256,8 @@ def _figure_sweep(args, taus, progress) -> dict:
             d = out / f'{gname}_{smoothing or "model"}'
             if progress:
                 print(f'[sweep] {label}, {gname} grid -> {d}', file=sys.stderr)
-            rows = sweep(base, taus, ths, args.duration, d, args.workers, progress, ros=args.ros)
+            rows = sweep(base, taus, ths, args.duration, d, args.workers, progress, ros=args.ros,
+                         scheduler=args.scheduler)
             b = boundaries(rows, taus, ths)
             panel.setdefault('classes', grid(rows, taus, ths))
             panel['curves'].append((label, style, ths, [r['first_unsettled_tau_s'] for r in b],
@@ -277,7 +279,7 @@ def _resolution_sweep(args, out: Path) -> int:
     if (scales < 0).any():
         raise ConfigError('--resolution-scale: scales must be >= 0 (0 = exact sensors, 1 = the scenario\'s)')
     base = _sweep_base(args.config, 'config', args.smoothing, args.cutoff_hz)
-    rows = resolution_study(base, scales, args.duration, args.scale_sensor, args.workers)
+    rows = resolution_study(base, scales, args.duration, args.scale_sensor, args.workers, args.scheduler)
     out.mkdir(parents=True, exist_ok=True)
     fig = resolution_figure(rows, f'{Path(args.config).stem}: oscillation against {args.scale_sensor} '
                             'encoder resolution',
@@ -309,7 +311,8 @@ def _threshold(args, out: Path) -> int:
     def progress(a, b):
         print(f'[threshold] settles from {a:.4g} rad, cycles from {b:.4g} rad', file=sys.stderr)
     try:
-        res = threshold_angle(base, lo, hi, args.duration, progress=None if args.json else progress)
+        res = threshold_angle(base, lo, hi, args.duration, progress=None if args.json else progress,
+                              scheduler=args.scheduler)
     except ValueError as exc:
         raise ConfigError(f'--threshold: {exc}') from exc
     res.update(config=args.config, sensors=args.sensors, cutoff_hz=base.controller.cutoff_hz,
@@ -335,6 +338,9 @@ def cmd_sweep(args) -> int:
         raise ConfigError(f'--tau/--theta0-deg: {exc}') from exc
     progress = None if args.json else print_progress
     out = Path(args.out)
+    if args.ros and args.scheduler:
+        raise ConfigError('--ros with --scheduler: a ROS cell runs three node processes on this machine; '
+                          'drop one of them')
     if args.figure:
         summary = _figure_sweep(args, taus, progress)
         (out / 'summary.json').write_text(json.dumps(summary, indent=2, default=float))
@@ -354,7 +360,8 @@ def cmd_sweep(args) -> int:
     if args.threshold:
         return _threshold(args, out)
     base = _sweep_base(args.config, args.sensors, args.smoothing, args.cutoff_hz)
-    rows = sweep(base, taus, ths, args.duration, out, args.workers, progress, ros=args.ros)
+    rows = sweep(base, taus, ths, args.duration, out, args.workers, progress, ros=args.ros,
+                 scheduler=args.scheduler)
     title = f'{Path(args.config).stem}: {base.friction.model}' + (
         f', tanh({base.friction.delta:g} v)' if base.friction.smoothing == 'tanh' else '')
     fig = stability_map(taus, ths, grid(rows, taus, ths), title, out / 'map.png')
@@ -372,6 +379,56 @@ def cmd_sweep(args) -> int:
         print(f'  theta0 {b["theta0_deg"]:6.3f} deg: settled up to tau = {b["last_settled_tau_s"]}, '
               f'falls from tau = {b["first_fallen_tau_s"]}')
     print(f'map: {fig}\ncells: {out / "cells.csv"}')
+    return 0
+
+
+def cmd_montecarlo(args) -> int:
+    """The hunting's distribution over N runs with parameters drawn from --spread or --from-ident."""
+    from functools import partial
+    if args.runs < 1:
+        raise ConfigError(f'--runs: {args.runs} must be >= 1')
+    if not (math.isfinite(args.duration) and args.duration > 0):
+        raise ConfigError(f'--duration: {args.duration!r} must be > 0 s')
+    if (args.spread is None) == (args.from_ident is None):
+        raise ConfigError('give either --spread NAME=S,... (relative spreads) or --from-ident DIR (an '
+                          'identification\'s parameter table)')
+    if args.workers is not None and args.workers < 1:
+        raise ConfigError(f'--workers: {args.workers} must be >= 1')
+    base = _sweep_base(args.config, args.sensors, None)
+    from .analysis.montecarlo import parse_spread, run_montecarlo, spread_draw, write_results
+    from .analysis.sweep import print_progress
+    info: dict = {'config': args.config, 'runs': args.runs, 'duration_s': args.duration, 'seed': args.seed,
+                  'sensors': args.sensors}
+    if args.spread is not None:
+        spread = parse_spread(args.spread)
+        draw = partial(spread_draw, base, spread, args.seed, distribution=args.distribution)
+        info['drawn'] = {'spread': spread, 'distribution': args.distribution,
+                         'meaning': 'value = nominal * (1 + s z), z ~ N(0, 1)' if args.distribution == 'normal'
+                         else 'value = nominal * (1 + s u), u ~ U(-1, 1)'}
+    else:
+        from .ident.uncertainty import load_report, report_draw
+        model, std, dt = load_report(args.from_ident)
+        draw = partial(report_draw, model, std, dt, base, args.seed)
+        info['drawn'] = {'from_ident': args.from_ident, 'std': std,
+                         'meaning': 'value ~ N(identified value, std^2), independent, clipped to the bounds'}
+    rows = run_montecarlo(draw, args.runs, args.duration, args.workers, args.scheduler,
+                      None if args.json else partial(print_progress, label='runs'))
+    title = f'{Path(args.config).stem}: {args.runs} runs of {args.duration:g} s, ' + (
+        f'spread {args.spread} ({args.distribution})' if args.spread else f'from {args.from_ident}')
+    summary = write_results(rows, info, args.out, title)
+    if args.json:
+        _print_json(summary)
+        return 0
+    print(f'{args.runs} runs: ' + ', '.join(f'{c} {100 * f:.1f} %' for c, f in summary['fraction'].items() if f))
+    for key, label, scale, unit in (('true_x_p2p_m', 'cart p2p', 100.0, 'cm'),
+                                    ('true_theta_p2p_rad', 'angle p2p', 180.0 / math.pi, 'deg'),
+                                    ('period_s', 'period', 1.0, 's')):
+        q = summary[key]
+        if q:
+            print(f'  {label:<10} 5/25/50/75/95 %: ' + ' / '.join(f'{scale * q[k]:.3g}' for k in
+                                                                  ('q05', 'q25', 'q50', 'q75', 'q95'))
+                  + f' {unit} ({q["runs"]} hunting runs)')
+    print(f'summary: {Path(args.out) / "summary.json"}\nruns: {summary["csv"]}\nfigure: {summary["figure"]}')
     return 0
 
 
@@ -680,7 +737,11 @@ def build_parser() -> argparse.ArgumentParser:
                    '(default %(default)s)')
     w.add_argument('--smoothing', choices=('none', 'tanh'), default=None, help='override the friction smoothing')
     w.add_argument('--workers', type=int, default=None,
-                   help='parallel cells (default: all cores offline, 1 with --ros)')
+                   help='parallel cells in local processes (default: all cores offline, 1 with --ros)')
+    w.add_argument('--scheduler', default=None, metavar='ADDRESS',
+                   help='run the cells on the Dask cluster whose scheduler listens at ADDRESS '
+                        '(e.g. tcp://10.0.0.5:8786; its workers run this project\'s environment), same rows '
+                        'as the local processes')
     w.add_argument('--ros', action='store_true',
                    help='run each cell through the ROS 2 nodes in lockstep (bags kept in OUT/ros)')
     w.add_argument('--figure', choices=sorted(FIGURES), default=None,
@@ -698,6 +759,30 @@ def build_parser() -> argparse.ArgumentParser:
     w.add_argument('--cutoff-hz', type=float, default=None,
                    help='override the controller\'s velocity filter corner [Hz] (0 = raw difference)')
     w.add_argument('--out', required=True, help='directory for cells.csv, map.png, summary.json')
+    mc = add('montecarlo', cmd_montecarlo, 'distribution of the hunting (cart and angle peak-to-peak, period, '
+             'class) over N runs of a scenario with its parameters drawn at random: relative spreads, or an '
+             'identification\'s parameter table with its standard errors; runs.csv, summary.json, histogram.png')
+    mc.add_argument('--config', default=str(REPO_ROOT / 'config' / 'default.yaml'),
+                    help='scenario whose parameters are drawn (default %(default)s)')
+    mc.add_argument('--runs', type=int, default=1000, help='number of runs (default %(default)s)')
+    mc.add_argument('--duration', type=float, default=20.0, help='simulated seconds per run (default %(default)s)')
+    mc.add_argument('--spread', metavar='NAME=S,...',
+                    help='relative 1-sigma spreads of plant or friction coefficients, e.g. mu_s=0.3,mu_c=0.3,eps=0.3 '
+                         '(30 %%); each value = nominal * (1 + S z), clipped to its range, mu_c <= mu_s')
+    mc.add_argument('--distribution', choices=('normal', 'uniform'), default='normal',
+                    help='--spread: z ~ N(0, 1) (S is one sigma) or z ~ U(-1, 1) (S is the half width) '
+                         '(default %(default)s)')
+    mc.add_argument('--from-ident', metavar='DIR',
+                    help='draw the fitted parameters of the final model of `./ipfric identify --out DIR` from '
+                         'N(value, std^2), independently (the report has standard errors, no covariance)')
+    mc.add_argument('--seed', type=int, default=0, help='seed; run i draws with the seed (seed, i) '
+                    '(default %(default)s)')
+    mc.add_argument('--sensors', choices=('exact', 'config'), default='config',
+                    help='the scenario\'s encoders, or exact states (default %(default)s)')
+    mc.add_argument('--workers', type=int, default=None, help='local processes (default: all cores)')
+    mc.add_argument('--scheduler', default=None, metavar='ADDRESS',
+                    help='run on the Dask cluster whose scheduler listens at ADDRESS (same rows as locally)')
+    mc.add_argument('--out', required=True, help='directory for runs.csv, summary.json, histogram.png')
     i = add('identify', cmd_identify, 'identify the cart\'s friction and undeclared effects from measured '
             'data (run bag, CSV, EMPS .mat, or "paper" for Tables 5-6): base fit, residual analysis, '
             'greedy effect search kept only when it pays on validation data; report, export, redesign')
@@ -766,6 +851,9 @@ def main(argv=None) -> int:
         return args.func(args)
     except ConfigError as exc:
         print(f'ipfric {args.command}: configuration error: {exc}', file=sys.stderr)
+        return 2
+    except SchedulerError as exc:
+        print(f'ipfric {args.command}: {exc}', file=sys.stderr)
         return 2
 
 

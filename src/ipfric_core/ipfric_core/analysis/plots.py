@@ -133,3 +133,23 @@ def resolution_figure(rows, title: str, path: str | Path) -> Path:
         ax.legend(fontsize=8)
     fig.suptitle(title)
     return _save(fig, path)
+
+
+def montecarlo_figure(rows, hunting, title: str, path: str | Path) -> Path:
+    """Histograms of the cart and angle peak-to-peak and of the period over the runs whose class is
+    in ``hunting`` (the true motion), with the share of every class in the title."""
+    runs = [r for r in rows if r['class'] in hunting]
+    fig, axes = plt.subplots(1, 3, figsize=(13, 4))
+    for ax, (key, scale, label) in zip(axes, (('true_x_p2p_m', 100.0, 'cart p2p (cm)'),
+                                              ('true_theta_p2p_rad', 180.0 / math.pi, 'angle p2p (deg)'),
+                                              ('period_s', 1.0, 'period (s)'))):
+        v = [scale * r[key] for r in runs if r[key] is not None]
+        if v:
+            ax.hist(v, bins=min(40, max(5, len(v) // 10)), color='#fdae61', edgecolor='k', lw=0.3)
+            ax.axvline(float(np.median(v)), color='k', ls=':', label=f'median {np.median(v):.3g}')
+            ax.legend(fontsize=8)
+        ax.set(xlabel=label, ylabel='runs')
+    shares = ', '.join(f'{c.replace("_", " ")} {100 * sum(r["class"] == c for r in rows) / len(rows):.0f} %'
+                       for c in CLASS_COLOURS if any(r['class'] == c for r in rows))
+    fig.suptitle(f'{title}\n{len(rows)} runs: {shares}')
+    return _save(fig, path)

@@ -2,23 +2,24 @@
 
 Each cell is one closed-loop run of a scenario with the controller delay and theta0
 replaced, classified by :func:`ipfric_core.analysis.oscillation.classify`. Cells run in parallel
-processes, are appended to ``cells.csv`` as they finish (so an interrupted sweep resumes
-without redoing them), and are deterministic: a cell's result depends only on its inputs.
+processes (local, or on a Dask cluster: ``scheduler``, :mod:`ipfric_core.executor`), are appended
+to ``cells.csv`` as they finish (so an interrupted sweep resumes without redoing them), and are
+deterministic: a cell's result depends only on its inputs.
 """
 from __future__ import annotations
 
 import csv
 import math
-import os
 import sys
 from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from ..constants import DURATION, LIMITS
+from ..executor import make_executor
 from ..physics.closedloop import run_closed_loop
 from ..run.scenario import Scenario
 from .oscillation import CLASSES, classify
@@ -43,6 +44,13 @@ def classify_run(scn: Scenario, duration: float, window: float = 10.0):
     tr = run_closed_loop(scn.make_rig(), scn.make_controller(), duration)
     return classify_samples(scn, tr.t, tr.measured[:, 0], tr.measured[:, 1], tr.end_reason != DURATION,
                             window), tr
+
+
+def true_p2p(o, tr) -> tuple[float, float]:
+    """Peak-to-peak of the true cart position [m] and angle [rad] of the Trajectory ``tr`` over the
+    window its Oscillation ``o`` was judged on (the measured ones are in encoder counts)."""
+    w = tr.t >= tr.t[-1] - o.window[1] + o.window[0]
+    return float(np.ptp(tr.state[w, 0])), float(np.ptp(tr.state[w, 1]))
 
 
 def run_cell(base: Scenario, tau: float, theta0_deg: float, duration: float,
@@ -109,11 +117,12 @@ def load_cells(path: Path) -> dict:
 
 def sweep(base: Scenario, taus, thetas_deg, duration: float, out_dir: str | Path,
           workers: int | None = None, progress: Callable[[int, int], None] | None = None,
-          ros: bool = False) -> list[dict]:
+          ros: bool = False, scheduler: str | None = None) -> list[dict]:
     """Run every (tau, theta0) cell not already in ``out_dir/cells.csv``; return all rows sorted.
 
     ``ros``: each cell through the ROS 2 loop in lockstep (bags kept in ``out_dir/ros``;
     one cell at a time unless ``workers`` says otherwise, each cell being three processes).
+    ``scheduler``: the cells run on that Dask cluster (:func:`ipfric_core.executor.make_executor`).
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -130,7 +139,7 @@ def sweep(base: Scenario, taus, thetas_deg, duration: float, out_dir: str | Path
         if progress:
             progress(finished, total)
         ros_dir = out / 'ros' if ros else None
-        with ProcessPoolExecutor(max_workers=workers or (1 if ros else os.cpu_count())) as pool:
+        with make_executor(scheduler, workers or (1 if ros else None)) as pool:
             futures = [pool.submit(run_cell, base, t, th, duration, ros_dir) for t, th in todo]
             for fut in as_completed(futures):
                 row = fut.result()
@@ -183,8 +192,8 @@ def parse_range(text: str) -> np.ndarray:
                          f'or a comma-separated list of numbers') from exc
 
 
-def print_progress(done: int, total: int) -> None:
-    sys.stderr.write(f'\r[sweep] {done}/{total} cells')
+def print_progress(done: int, total: int, label: str = 'cells') -> None:
+    sys.stderr.write(f'\r[sweep] {done}/{total} {label}')
     if done == total:
         sys.stderr.write('\n')
     sys.stderr.flush()
@@ -200,44 +209,52 @@ def resolution_cell(base: Scenario, scale: float, duration: float, sensor: str =
         s, cart_resolution=s.cart_resolution * (scale if sensor in ('cart', 'both') else 1.0),
         angle_resolution=s.angle_resolution * (scale if sensor in ('angle', 'both') else 1.0)))
     o, tr = classify_run(scn, duration)
-    w = tr.t >= tr.t[-1] - o.window[1] + o.window[0]      # the true motion over the same window
+    true_x, true_theta = true_p2p(o, tr)
     return {'scale': float(scale), 'cart_resolution_m': scn.sim.cart_resolution,
             'angle_resolution_rad': scn.sim.angle_resolution, 'class': o.cls,
             'x_p2p_m': o.x_p2p, 'theta_p2p_rad': o.theta_p2p, 'period_s': o.period_crossings,
-            'true_x_p2p_m': float(np.ptp(tr.state[w, 0])), 'true_theta_p2p_rad': float(np.ptp(tr.state[w, 1]))}
+            'true_x_p2p_m': true_x, 'true_theta_p2p_rad': true_theta}
 
 
 def resolution_study(base: Scenario, scales, duration: float, sensor: str = 'angle',
-                     workers: int | None = None) -> list[dict]:
-    """Oscillation against encoder resolution (section 6), one run per scale of the scenario's count(s)."""
+                     workers: int | None = None, scheduler: str | None = None) -> list[dict]:
+    """Oscillation against encoder resolution (section 6), one run per scale of the scenario's count(s);
+    in local processes, or on the Dask cluster at ``scheduler``."""
     n = len(scales)
-    with ProcessPoolExecutor(max_workers=workers or os.cpu_count()) as pool:
+    with make_executor(scheduler, workers) as pool:
         return list(pool.map(resolution_cell, [base] * n, scales, [duration] * n, [sensor] * n))
 
 
+def angle_class(base: Scenario, theta0: float, duration: float, window: float):
+    """The Oscillation of ``base`` run offline from the initial angle ``theta0`` [rad]."""
+    return classify_run(replace(base, sim=replace(base.sim, theta0=theta0)), duration, window)[0]
+
+
 def threshold_angle(base: Scenario, lo: float, hi: float, duration: float, rtol: float = 0.01,
-                    window: float = 20.0, progress: Callable[[float, float], None] | None = None) -> dict:
+                    window: float = 20.0, progress: Callable[[float, float], None] | None = None,
+                    scheduler: str | None = None) -> dict:
     """Bisect the initial angle [rad] separating convergence from the periodic orbit.
 
     Requires the run from ``lo`` to settle and the run from ``hi`` not to (Figure 8(b):
     bistability of the equilibrium and a limit cycle). Stops when hi - lo < rtol * hi.
+    The two bracket runs go in parallel, then one run per bisection step, in local
+    processes or on the Dask cluster at ``scheduler``.
     """
-    def cls(theta0):
-        return classify_run(replace(base, sim=replace(base.sim, theta0=theta0)), duration, window)[0]
-    c_lo, c_hi = cls(lo), cls(hi)
-    if c_lo.cls != 'settled' or c_hi.cls == 'settled':
-        raise ValueError(f'theta0 = {lo:g} rad gives {c_lo.cls} and {hi:g} rad gives {c_hi.cls}: '
-                         f'the bracket must go from settled to not settled')
-    runs = 2
-    while hi - lo > rtol * hi:
-        mid = math.sqrt(lo * hi) if lo > 0 else 0.5 * hi
-        o = cls(mid)
-        runs += 1
-        if o.cls == 'settled':
-            lo = mid
-        else:
-            hi, c_hi = mid, o
-        if progress:
-            progress(lo, hi)
+    with make_executor(scheduler, 2) as pool:
+        c_lo, c_hi = pool.map(angle_class, [base] * 2, [lo, hi], [duration] * 2, [window] * 2)
+        if c_lo.cls != 'settled' or c_hi.cls == 'settled':
+            raise ValueError(f'theta0 = {lo:g} rad gives {c_lo.cls} and {hi:g} rad gives {c_hi.cls}: '
+                             f'the bracket must go from settled to not settled')
+        runs = 2
+        while hi - lo > rtol * hi:
+            mid = math.sqrt(lo * hi) if lo > 0 else 0.5 * hi
+            o = pool.submit(angle_class, base, mid, duration, window).result()
+            runs += 1
+            if o.cls == 'settled':
+                lo = mid
+            else:
+                hi, c_hi = mid, o
+            if progress:
+                progress(lo, hi)
     return {'settles_below_rad': lo, 'oscillates_from_rad': hi, 'runs': runs,
             'hi_class': c_hi.cls, 'hi_x_p2p_m': c_hi.x_p2p, 'hi_period_s': c_hi.period_crossings}

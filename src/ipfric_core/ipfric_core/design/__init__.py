@@ -1,7 +1,8 @@
 """Design on the physics (paper sections 3-5): linearization, LQR, Routh-Hurwitz, the critical
-delay, friction estimates from the appendix tables, the printed numbers.
+delay, the describing-function prediction of the hunting, friction estimates from the appendix
+tables, the printed numbers.
 
-Modules: continuation, critical_delay, estimation, linearize, lqr, orbit, paper, paperconfig, reports, stability.
+Modules: continuation, critical_delay, describing, estimation, linearize, lqr, orbit, paper, paperconfig, reports, stability.
 Every public name below is loaded from its module on first use, so importing the package
 stays cheap."""
 from __future__ import annotations
@@ -10,6 +11,7 @@ from ..lazy import lazy_getattr
 
 #: public name -> module that defines it
 _WHERE = {
+    'AMPLITUDE_RANGE': 'describing',
     'BREAKAWAY_MEAN_V': 'paper',
     'BranchPoint': 'continuation',
     'CONTROL_WEIGHT': 'lqr',
@@ -23,12 +25,14 @@ _WHERE = {
     'EIG_DYNAMIC_GAIN_15': 'paper',
     'EIG_DYNAMIC_GAIN_25': 'paper',
     'EPS': 'paper',
+    'FrictionNonlinearity': 'describing',
     'GAIN_15_VISCOUS': 'paper',
     'GAIN_23_EXPONENTIAL': 'paper',
     'GAIN_25_DYNAMIC': 'paper',
     'LoopNumbers': 'orbit',
     'MU_C': 'paper',
     'MU_S': 'paper',
+    'OMEGA_RANGE': 'describing',
     'Orbit': 'orbit',
     'OrbitError': 'orbit',
     'PaperConfig': 'paperconfig',
@@ -53,6 +57,11 @@ _WHERE = {
     'find_orbit': 'orbit',
     'free_entries': 'orbit',
     'friction_estimates': 'reports',
+    'friction_loop': 'describing',
+    'friction_to_state': 'describing',
+    'harmonic_balance': 'describing',
+    'hunting_over_delays': 'describing',
+    'hunting_over_gain_scales': 'describing',
     'jacobian': 'linearize',
     'load_paper_config': 'paperconfig',
     'load_table5': 'estimation',
@@ -60,6 +69,7 @@ _WHERE = {
     'loop_numbers': 'orbit',
     'lqr_gain': 'lqr',
     'parse_continuation': 'continuation',
+    'predict_hunting': 'describing',
     'resized': 'orbit',
     'return_map': 'orbit',
     'rhp_root_count': 'stability',
@@ -75,8 +85,8 @@ _WHERE = {
     'trace': 'continuation',
     'unstable_partners': 'continuation',
 }
-_MODULES = ['continuation', 'critical_delay', 'estimation', 'linearize', 'lqr', 'orbit', 'paper',
-            'paperconfig', 'reports', 'stability']
+_MODULES = ['continuation', 'critical_delay', 'describing', 'estimation', 'linearize', 'lqr', 'orbit',
+            'paper', 'paperconfig', 'reports', 'stability']
 
 __all__ = sorted(_WHERE) + _MODULES
 __getattr__ = lazy_getattr(__name__, _WHERE, _MODULES)

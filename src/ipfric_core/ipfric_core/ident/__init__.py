@@ -2,8 +2,8 @@
 residual analysis, reports, experiments and the redesign loop.
 
 Modules: effects, equation_error, excitation, ladder, ladder_report, model, records,
-redesign, report, residual, shooting. Every public name below is loaded from its module on
-first use, so importing the package stays cheap."""
+redesign, report, residual, shooting, uncertainty. Every public name below is loaded from its
+module on first use, so importing the package stays cheap."""
 from __future__ import annotations
 
 from ..lazy import lazy_getattr
@@ -112,6 +112,7 @@ _WHERE = {
     'load_csv': 'records',
     'load_declared': 'model',
     'load_emps': 'records',
+    'load_report': 'uncertainty',
     'local_rate': 'shooting',
     'make_windows': 'shooting',
     'markdown': 'report',
@@ -127,6 +128,7 @@ _WHERE = {
     'predict': 'shooting',
     'rates': 'shooting',
     'reading_errors': 'shooting',
+    'report_draw': 'uncertainty',
     'residual_vector': 'equation_error',
     'resisting_force': 'effects',
     'resolved': 'equation_error',
@@ -156,7 +158,7 @@ _WHERE = {
     'write_report': 'report',
 }
 _MODULES = ['effects', 'equation_error', 'excitation', 'ladder', 'ladder_report', 'model', 'records',
-            'redesign', 'report', 'residual', 'shooting']
+            'redesign', 'report', 'residual', 'shooting', 'uncertainty']
 
 __all__ = sorted(_WHERE) + _MODULES
 __getattr__ = lazy_getattr(__name__, _WHERE, _MODULES)

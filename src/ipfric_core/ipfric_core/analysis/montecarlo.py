@@ -1,0 +1,157 @@
+"""Monte Carlo over parameter uncertainty: the distribution of the hunting of a scenario.
+
+N runs of a scenario, each with its parameters drawn at random, each classified like a
+sweep cell (:func:`ipfric_core.analysis.sweep.classify_run`): class, cart and angle
+peak-to-peak [m, rad] and period [s] of the final regime. Draws come from
+:func:`spread_draw` (relative spreads on plant and friction coefficients) or from an
+identification's parameter table (:func:`ipfric_core.ident.uncertainty.report_draw`).
+
+Run i draws from its own generator, seeded by (seed, i): its parameters depend on the
+seed and i only, not on N or on where it runs, and its result only on its parameters, so
+the rows are the same in local processes and on a Dask cluster (:mod:`ipfric_core.executor`).
+"""
+from __future__ import annotations
+
+import csv
+import json
+import math
+from collections.abc import Callable
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..executor import make_executor
+from ..physics.params import FRICTION_FIELDS, PLANT_FIELDS, ConfigError, Field
+from ..run.scenario import Scenario
+from .oscillation import CLASSES
+from .sweep import classify_run, true_p2p
+
+#: how a relative spread s turns into a factor on the nominal value
+DISTRIBUTIONS = ('normal', 'uniform')   # 1 + s z with z ~ N(0, 1), or 1 + s u with u ~ U(-1, 1)
+#: coefficients a spread can name: section of the scenario and schema
+SPREAD_FIELDS: dict[str, tuple[str, Field]] = {
+    **{k: ('plant', f) for k, f in PLANT_FIELDS.items() if k != 'g'},
+    **{k: ('friction', f) for k, f in FRICTION_FIELDS.items()
+       if k not in ('delta', 'asymmetry', 'asymmetry_viscous')},
+}
+#: columns of a run's row after its drawn parameters: measured (encoder) and true peak-to-peak
+RESULT_FIELDS = ('class', 'transition_time_s', 'x_p2p_m', 'theta_p2p_rad', 'true_x_p2p_m', 'true_theta_p2p_rad',
+                 'period_s')
+#: classes of a hunting run (a sustained oscillation), whose amplitudes and periods are summarized
+HUNTING = ('limit_cycle', 'irregular')
+QUANTILES = (0.05, 0.25, 0.5, 0.75, 0.95)
+#: runs per task sent to a worker
+CHUNK = 25
+
+
+def parse_spread(text: str) -> dict[str, float]:
+    """'mu_s=0.3,mu_c=0.3' -> {'mu_s': 0.3, 'mu_c': 0.3}: relative spreads (0.3 = 30 %)."""
+    out: dict[str, float] = {}
+    for item in text.split(','):
+        name, _, value = item.partition('=')
+        name = name.strip()
+        if name not in SPREAD_FIELDS:
+            raise ConfigError(f'--spread: {name!r} is not a coefficient that can be drawn; allowed: '
+                              f'{", ".join(SPREAD_FIELDS)}')
+        try:
+            s = float(value)
+        except ValueError:
+            raise ConfigError(f'--spread: {item!r} is not NAME=SPREAD (e.g. mu_s=0.3 for 30 %)') from None
+        if not (math.isfinite(s) and 0.0 <= s <= 1.0):
+            raise ConfigError(f'--spread: {name} = {value}: the relative spread must be in [0, 1]')
+        out[name] = s
+    return out
+
+
+def clip_to_range(value: float, spec: Field) -> float:
+    """``value`` inside the schema's range (an open lower bound: just above it)."""
+    lo = math.nextafter(spec.lo, math.inf) if spec.lo_open else spec.lo
+    return min(max(value, lo), spec.hi)
+
+
+def spread_draw(base: Scenario, spread: dict[str, float], seed: int, index: int,
+                distribution: str = 'normal') -> tuple[dict, Scenario]:
+    """Run ``index``'s coefficients: each nominal value times 1 + s z (``DISTRIBUTIONS``), clipped to
+    its range, mu_c kept <= mu_s (eq. 8); (the drawn values, ``base`` with them in plant and friction)."""
+    rng = np.random.default_rng([seed, index])
+    z = rng.standard_normal(len(spread)) if distribution == 'normal' else rng.uniform(-1.0, 1.0, len(spread))
+    sections = {'plant': base.plant, 'friction': base.friction}
+    values = {}
+    for (name, s), zi in zip(sorted(spread.items()), z):
+        section, spec = SPREAD_FIELDS[name]
+        values[name] = clip_to_range(getattr(sections[section], name) * (1.0 + s * zi), spec)
+    drawn: dict[str, dict[str, Any]] = {'plant': {}, 'friction': {}}
+    for k, v in values.items():
+        drawn[SPREAD_FIELDS[k][0]][k] = v
+    plant, friction = replace(base.plant, **drawn['plant']), replace(base.friction, **drawn['friction'])
+    if friction.mu_c > friction.mu_s:
+        friction = replace(friction, mu_c=friction.mu_s)
+        values['mu_c'] = friction.mu_s
+    return values, replace(base, plant=plant, friction=friction)
+
+
+def run_chunk(chunk, duration: float) -> list[dict]:
+    """Rows of runs (index, drawn values, scenario): the values, then the classification."""
+    rows = []
+    for index, values, scn in chunk:
+        o, tr = classify_run(scn, duration)
+        true_x, true_theta = true_p2p(o, tr)
+        rows.append({'run': index, **values, 'class': o.cls, 'transition_time_s': o.transition_time,
+                     'x_p2p_m': o.x_p2p, 'theta_p2p_rad': o.theta_p2p, 'true_x_p2p_m': true_x,
+                     'true_theta_p2p_rad': true_theta, 'period_s': o.period_crossings})
+    return rows
+
+
+def run_montecarlo(draw: Callable[[int], tuple[dict, Scenario]], runs: int, duration: float,
+               workers: int | None = None, scheduler: str | None = None,
+               progress: Callable[[int, int], None] | None = None) -> list[dict]:
+    """``runs`` runs of ``duration`` [s], run i with the parameters ``draw(i)``; rows in run order.
+
+    In local processes (``workers``, default all cores) or on the Dask cluster at ``scheduler``.
+    """
+    runs_in = [(i, *draw(i)) for i in range(runs)]
+    chunks = [runs_in[a:a + CHUNK] for a in range(0, runs, CHUNK)]
+    rows: list[dict] = []
+    with make_executor(scheduler, workers) as pool:
+        for part in pool.map(run_chunk, chunks, [duration] * len(chunks)):
+            rows += part
+            if progress:
+                progress(len(rows), runs)
+    return rows
+
+
+def _quantiles(values) -> dict | None:
+    v = np.asarray([x for x in values if x is not None], float)
+    if not len(v):
+        return None
+    return {f'q{round(100 * q):02d}': float(np.quantile(v, q)) for q in QUANTILES} | {
+        'mean': float(v.mean()), 'std': float(v.std()), 'runs': len(v)}
+
+
+def summarize(rows: list[dict]) -> dict:
+    """Fraction of runs per class; quantiles (5, 25, 50, 75, 95 %), mean and std of the cart and angle
+    peak-to-peak [m, rad] (measured and true) and of the period [s] over the hunting runs (``HUNTING``)."""
+    n = len(rows)
+    hunting = [r for r in rows if r['class'] in HUNTING]
+    return {'runs': n,
+            'fraction': {c: sum(r['class'] == c for r in rows) / n for c in CLASSES},
+            'hunting_fraction': len(hunting) / n,
+            **{k: _quantiles(r[k] for r in hunting) for k in RESULT_FIELDS[2:]}}
+
+
+def write_results(rows: list[dict], info: dict, out: str | Path, title: str) -> dict:
+    """``out/runs.csv`` (one row per run), ``out/summary.json`` (``info`` and :func:`summarize`) and
+    ``out/histogram.png``; returns the summary."""
+    from .plots import montecarlo_figure
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    with open(out / 'runs.csv', 'w', newline='') as fh:
+        w = csv.DictWriter(fh, list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    summary = {**info, **summarize(rows), 'csv': str(out / 'runs.csv')}
+    summary['figure'] = str(montecarlo_figure(rows, HUNTING, title, out / 'histogram.png'))
+    (out / 'summary.json').write_text(json.dumps(summary, indent=2, default=float))
+    return summary

@@ -1,0 +1,65 @@
+"""Where parallel runs execute: a local process pool, or a Dask cluster (``--scheduler ADDRESS``).
+
+:func:`make_executor` is the one place that makes an executor; the sweeps, the resolution
+study, the threshold bisection and the Monte Carlo submit their runs to what it returns
+(a ``concurrent.futures.Executor``, so ``submit``, ``map`` and ``with`` work alike). A
+run's result depends only on its inputs, so the rows are the same wherever it runs.
+
+A cluster's workers import ``ipfric_core`` themselves: start them in this project's
+environment (``dask scheduler`` and ``dask worker ADDRESS`` after ``source scripts/env.sh``).
+Importing this module loads nothing of Dask; only a scheduler address does.
+"""
+from __future__ import annotations
+
+import os
+from concurrent.futures import Executor, ProcessPoolExecutor
+
+#: seconds to wait for the scheduler before giving up
+CONNECT_TIMEOUT_S = 5.0
+
+
+class SchedulerError(ConnectionError):
+    """The Dask scheduler of ``--scheduler`` cannot be reached (or the address is malformed)."""
+
+
+def make_executor(scheduler: str | None = None, workers: int | None = None,
+                  timeout: float = CONNECT_TIMEOUT_S) -> Executor:
+    """An executor for independent runs.
+
+    scheduler : None for a local ``ProcessPoolExecutor``, or the address of a running
+        ``dask.distributed`` scheduler (e.g. ``tcp://10.0.0.5:8786``).
+    workers : local processes (default: all cores); a cluster has its own workers.
+    timeout : seconds to wait for the scheduler [s]; past it :class:`SchedulerError`.
+    """
+    if scheduler is None:
+        return ProcessPoolExecutor(max_workers=workers or os.cpu_count())
+    from distributed import Client
+    try:
+        client = Client(scheduler, timeout=timeout, set_as_default=False)
+    except Exception as exc:  # refused, timed out, malformed address, not a scheduler at all
+        raise SchedulerError(f'--scheduler {scheduler}: no Dask scheduler answers there within {timeout:g} s '
+                             f'({type(exc).__name__}: {exc}); start one with `dask scheduler` and give '
+                             f'its address, e.g. tcp://HOST:8786') from exc
+    return ClusterExecutor(client)
+
+
+class ClusterExecutor(Executor):
+    """A ``concurrent.futures`` executor on a Dask client, which closes the client on shutdown.
+
+    Tasks are submitted as impure (``pure=False``): each submission runs, none is taken from
+    another with equal arguments.
+    """
+
+    def __init__(self, client):
+        self.client = client
+        self.executor = client.get_executor(pure=False)
+
+    def submit(self, fn, /, *args, **kwargs):
+        return self.executor.submit(fn, *args, **kwargs)
+
+    def map(self, fn, *iterables, timeout=None, chunksize=1):
+        return self.executor.map(fn, *iterables, timeout=timeout)
+
+    def shutdown(self, wait=True, *, cancel_futures=False):
+        self.executor.shutdown(wait=wait and not cancel_futures)
+        self.client.close()

@@ -1,0 +1,63 @@
+"""The uncertainty an identification leaves: draws of the rig from its parameter table.
+
+``./ipfric identify --out DIR`` writes ``DIR/result.json`` with the ladder's final model:
+every parameter with its value and, for the fitted ones, its standard error (from the
+Jacobian of the simulation error at the optimum). :func:`load_report` rebuilds that
+:class:`~ipfric_core.ident.model.Model`; :func:`report_draw` draws each fitted parameter
+from an independent Gaussian N(value, std^2) (the report holds standard errors, not their
+covariance), clipped to the parameter's bounds, and turns the draw into the scenario's
+plant, friction and ``plant_truth`` by the model's own export (the same conversion as
+``--export``). Parameters without a finite standard error keep their value.
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from ..physics.params import ConfigError, FrictionParams, PlantParams
+from ..run.scenario import Scenario
+from .model import PLANT_KNOWN, Model, declared
+
+
+def load_report(path: str | Path) -> tuple[Model, dict[str, float], float]:
+    """(final model, standard error of each fitted parameter, sample period [s]) of an
+    identification directory (or its ``result.json``)."""
+    path = Path(path)
+    file = path / 'result.json' if path.is_dir() else path
+    try:
+        r = json.loads(file.read_text())
+    except (OSError, ValueError) as exc:
+        raise ConfigError(f'--from-ident: {file}: cannot read it as JSON ({exc}); give the --out directory '
+                          f'of ./ipfric identify') from exc
+    if not isinstance(r, dict) or 'ladder' not in r or 'identified' not in r:
+        raise ConfigError(f'--from-ident: {file} is not the result of a ladder identification (no ladder and '
+                          f'identified sections; a force-input record such as EMPS has no rig to simulate)')
+    idf, last = r['identified'], r['ladder'][-1]
+    model = declared(PlantParams(**idf['plant']), FrictionParams(**idf['friction']), r['data']['pendulum'])
+    for effect in last['effects']:
+        model = model.with_effect(effect)
+    model = model.freeing([p['name'] for p in last['params'] if p['fitted'] and p['name'] in PLANT_KNOWN])
+    model = model.with_values({p['name']: p['value'] for p in last['params']})
+    std = {p['name']: float(p['std']) for p in last['params']
+           if p['fitted'] and p['std'] is not None and math.isfinite(p['std']) and p['std'] > 0}
+    return model, std, float(r['data']['sample_period_s'])
+
+
+def report_draw(model: Model, std: dict[str, float], dt: float, base: Scenario, seed: int,
+                index: int) -> tuple[dict, Scenario]:
+    """Run ``index``: each parameter of ``std`` drawn from N(value, std^2) with the generator
+    seeded by (seed, index), clipped to its bounds; (the drawn values, ``base`` with the
+    drawn model's plant, friction and plant_truth; the controller stays ``base``'s)."""
+    rng = np.random.default_rng([seed, index])
+    names = sorted(std)
+    z = rng.standard_normal(len(names))
+    values = {}
+    for name, zi in zip(names, z):
+        p = model.param(name)
+        values[name] = min(max(p.value + std[name] * zi, p.lo), p.hi)
+    m = model.with_values(values)
+    return values, replace(base, plant=m.plant_params(), friction=m.friction_params(), truth=m.plant_truth(dt))

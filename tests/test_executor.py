@@ -1,0 +1,68 @@
+"""Runs on a Dask cluster give the rows of the local process pool; a dead scheduler is a clear error."""
+import socket
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ipfric_core.analysis.montecarlo import run_montecarlo, spread_draw
+from ipfric_core.analysis.sweep import sweep
+from ipfric_core.cli import main
+from ipfric_core.executor import SchedulerError, make_executor
+from ipfric_core.run.scenario import load_scenario
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope='module')
+def cluster():
+    """A Dask cluster on loopback: 2 worker processes of 1 thread, no dashboard."""
+    distributed = pytest.importorskip('distributed')
+    with distributed.LocalCluster(host='127.0.0.1', n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as c:
+        yield c.scheduler_address
+
+
+@pytest.fixture(scope='module')
+def fig9_exact():
+    s = load_scenario(ROOT / 'config' / 'fig9_new_gain_exponential.yaml')
+    return replace(s, sim=replace(s.sim, cart_resolution=0.0, angle_resolution=0.0))
+
+
+def test_sweep_on_the_cluster_gives_the_local_rows(cluster, fig9_exact, tmp_path):
+    taus, ths = np.array([0.0, 0.02, 0.04]), np.array([1.0, 3.0])
+    local = sweep(fig9_exact, taus, ths, 5.0, tmp_path / 'local', workers=2)
+    remote = sweep(fig9_exact, taus, ths, 5.0, tmp_path / 'dask', scheduler=cluster)
+    assert remote == local
+    assert (tmp_path / 'dask' / 'cells.csv').read_text() == (tmp_path / 'local' / 'cells.csv').read_text()
+    assert {r['class'] for r in local} >= {'settled', 'fallen'}
+
+
+def test_montecarlo_on_the_cluster_gives_the_local_rows(cluster, tmp_path):
+    base = load_scenario(ROOT / 'config' / 'default.yaml')
+
+    def draw(i):
+        return spread_draw(base, {'mu_s': 0.3, 'mu_c': 0.3, 'eps': 0.3}, 11, i)
+    local = run_montecarlo(draw, 30, 5.0, workers=2)
+    remote = run_montecarlo(draw, 30, 5.0, scheduler=cluster)
+    assert remote == local
+    assert len({r['x_p2p_m'] for r in local}) > 10          # the draws differ, and so do the runs
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(('127.0.0.1', 0))
+        return s.getsockname()[1]
+
+
+@pytest.mark.timeout(60)
+def test_unreachable_scheduler_is_a_clear_error(tmp_path, capsys):
+    address = f'tcp://127.0.0.1:{free_port()}'
+    with pytest.raises(SchedulerError, match='--scheduler'):
+        make_executor(address, timeout=1.0)
+    code = main(['sweep', '--tau', '0', '--theta0-deg', '1', '--duration', '1', '--scheduler', address,
+                 '--out', str(tmp_path / 'out')])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert f'--scheduler {address}' in err and 'no Dask scheduler' in err
