@@ -650,8 +650,16 @@ def cmd_orbit(args) -> int:
             wr.writerows(rows)
         if not args.no_plots:
             from .analysis.bifurcation import diagram
-            res['continuation']['plot'] = str(diagram(base, name, values, rows, events, out / 'bifurcation.png',
-                                                      args.describing))
+            df = None
+            if args.describing and name in ('delay', 'gain'):
+                from .design.describing import hunting_over_delays, hunting_over_gain_scales
+                c = base.controller
+                df = (hunting_over_delays(base.plant, base.friction, base.gain(), values, c.cutoff_hz)
+                      if name == 'delay' else
+                      hunting_over_gain_scales(base.plant, base.friction, base.gain(), values, c.delay, c.cutoff_hz))
+                df = [{'parameter': v, 'x_p2p_m': d['x_p2p_m']} for v, d in zip(values, df) if d['intersection']]
+                res['continuation']['describing_function'] = df
+            res['continuation']['plot'] = str(diagram(base, name, values, rows, events, out / 'bifurcation.png', df))
     (out / 'orbit.json').write_text(json.dumps(res, indent=2, default=float))
     if args.json:
         _print_json(res)
@@ -831,7 +839,7 @@ def build_parser() -> argparse.ArgumentParser:
     o.add_argument('--simulate', type=float, default=120.0,
                    help='also run the loop this many seconds and report its cycle beside the orbit (0 = no)')
     o.add_argument('--describing', action='store_true',
-                   help='with --continue: draw the describing-function prediction on the diagram')
+                   help='with --continue over delay or gain: the describing-function prediction on the diagram')
     o.add_argument('--no-plots', action='store_true', help='numbers only')
     o.add_argument('--out', default='runs/orbit', help='directory for orbit.json, branches.csv, bifurcation.png '
                    '(default %(default)s)')

@@ -2,7 +2,8 @@
 delay, the describing-function prediction of the hunting, friction estimates from the appendix
 tables, the printed numbers.
 
-Modules: continuation, critical_delay, describing, estimation, linearize, lqr, orbit, paper, paperconfig, reports, stability.
+Modules: continuation, critical_delay, describing, estimation, linearize, lqr, orbit, paper, paperconfig,
+reports, stability.
 Every public name below is loaded from its module on first use, so importing the package
 stays cheap."""
 from __future__ import annotations
