@@ -62,13 +62,18 @@ def rates(t: np.ndarray, y: np.ndarray, valid: np.ndarray) -> np.ndarray:
     return np.interp(t, grid, np.gradient(f, dt))
 
 
-def local_rate(t: np.ndarray, y: np.ndarray, k: int, half_s: float = 0.01) -> float:
-    """dy/dt at sample k [unit/s]: slope of a quadratic fitted over +/- ``half_s`` (at least two
-    samples each side), which follows a quantized signal through fast changes."""
+def local_rate(t: np.ndarray, y: np.ndarray, k: int, valid: np.ndarray, half_s: float = 0.01) -> float:
+    """dy/dt at sample k [unit/s]: slope of a quadratic fitted over the ``valid`` samples nearest
+    to k, as many each side as +/- ``half_s`` holds at the median period (at least two), which
+    follows a quantized signal through fast changes. A stale reading repeats an old position at
+    a new time: beside a sample overrun it would bend the fit by the motion it missed, so the fit
+    reaches past it to the fresh readings on that side."""
     dt = float(np.median(np.diff(t)))
     h = max(2, int(round(half_s / dt)))
-    lo, hi = max(0, k - h), min(len(t), k + h + 1)
-    c = np.polyfit(t[lo:hi] - t[k], y[lo:hi], 2)
+    idx = np.flatnonzero(valid)
+    at = int(np.searchsorted(idx, k))
+    use = idx[max(0, at - h):at + h + 1]
+    c = np.polyfit(t[use] - t[k], y[use], 2)
     return float(c[1])
 
 
@@ -116,8 +121,8 @@ def make_windows(rec: Record, length_s: float, forced: bool = False, span: float
             k = end - 1
     start, stop = np.array(starts, int), np.array(stops, int)
     held = rest[start].astype(float)
-    v = np.array([0.0 if h else local_rate(t, x, k) for k, h in zip(start, held)])
-    w = (np.array([local_rate(t, th, k) for k in start]) if rec.theta is not None
+    v = np.array([0.0 if h else local_rate(t, x, k, rec.valid_mask) for k, h in zip(start, held)])
+    w = (np.array([local_rate(t, th, k, rec.valid_mask) for k in start]) if rec.theta is not None
          else np.zeros(len(start)))
     state = np.column_stack([x[start], th[start], v, w, np.zeros(len(start))])
     angle = (np.column_stack([th, rates(t, th, rec.valid_mask)]) if forced else np.zeros((0, 2)))
