@@ -88,6 +88,8 @@ _WHERE = {
     'delayed': 'shooting',
     'design_friction': 'redesign',
     'designed_gain': 'redesign',
+    'drive_crossings': 'ladder',
+    'drive_states': 'shooting',
     'dwell_profile': 'effects',
     'effect_starts': 'ladder',
     'effective_input': 'effects',

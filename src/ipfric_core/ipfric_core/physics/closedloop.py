@@ -7,7 +7,7 @@ Two engines run it. ``python`` steps the :class:`Rig` and :class:`StateFeedback`
 (as the ROS nodes do). ``compiled`` runs the whole loop in one numba function built from
 the same scalar functions (integrator, friction, plant, encoder, input effects,
 velocity filter, feedback), so both give the same trajectory; it needs fresh objects
-(nothing stepped yet) and covers every rig effect except sensor noise. ``auto`` takes
+(nothing stepped yet) and covers every rig effect except sensor noise and a drive with play. ``auto`` takes
 the compiled engine whenever it can.
 """
 from __future__ import annotations
@@ -51,6 +51,8 @@ def compiled_unsupported(rig: Rig, controller: StateFeedback) -> str | None:
         return 'the controller has already been updated'
     if rig.effects.noise_x_m or rig.effects.noise_theta_rad:
         return 'sensor noise (plant_truth.noise_*) is drawn by the python engine only'
+    if rig.effects.drive_backlash_m:
+        return 'a drive with play (plant_truth.drive_backlash_m) is integrated by the python engine only'
     return None
 
 

@@ -112,6 +112,44 @@ NO_EXTRA_FORCE = (0.0, 1.0, 0.0, 0.0)
 
 
 @compiled
+def motor_side_free(pp, mass: float, vb: float, voltage: float, h: float):
+    """Motor side of a drive with play, out of contact with the cart, over ``h`` [s].
+
+    The motor's rotor and gears reflected to the rack as a mass ``mass`` [kg] driven by the
+    motor force of eq. (2) on its own speed: mass vb' = alpha V - beta vb. Exact solution:
+    it tends to alpha V / beta [m/s] with time constant mass / beta [s] (at once for a
+    massless motor side). Returns (displacement [m], final speed vb [m/s]).
+    """
+    alpha, beta = pp[ALPHA], pp[BETA]
+    if beta <= 0.0:
+        if mass <= 0.0:
+            return vb * h, vb
+        a = alpha * voltage / mass
+        return vb * h + 0.5 * a * h * h, vb + a * h
+    v_inf = alpha * voltage / beta
+    if mass <= 0.0:
+        return v_inf * h, v_inf
+    tau = mass / beta
+    e = math.exp(-h / tau)
+    return v_inf * h + (vb - v_inf) * tau * (1.0 - e), v_inf + (vb - v_inf) * e
+
+
+@compiled
+def drive_impact(pp, mass: float, s, vb: float):
+    """State ``s`` of the cart after the motor side (mass [kg], speed vb [m/s]) closes the play.
+
+    A plastic impact (a stiff contact that does not bounce: the two move on together): the
+    impulse J on the cart changes x' by J / m_e, m_e = M + m - 3/4 m cos^2(theta) its
+    effective mass with the pendulum hinged (eq. 16), and theta' by -3/4 cos(theta) dx' / l
+    (the pendulum's equation integrated over the impulse); momentum m_e x' + mass vb is kept.
+    """
+    c = math.cos(s[1])
+    me = pp[M] + pp[MP] - 0.75 * pp[MP] * c * c
+    dv = (me * s[2] + mass * vb) / (me + mass) - s[2]
+    return (s[0], s[1], s[2] + dv, s[3] - 0.75 * c * dv / pp[L], s[4])
+
+
+@compiled
 def undeclared_forces(ef, x):
     """:func:`undeclared_force` along sampled positions ``x`` [m]."""
     out = np.empty(len(x))

@@ -28,8 +28,10 @@ from .friction import friction_force, holding_margin, holds, sticks
 from .plant import (
     NO_EXTRA_FORCE,
     CartPendulum,
+    drive_impact,
     held_force,
     motor_force,
+    motor_side_free,
     rates,
     stuck_theta_acceleration,
     undeclared_force,
@@ -37,6 +39,8 @@ from .plant import (
 
 MAX_EVENTS = 64  # per substep; a guard, never reached in normal motion
 XTOL = 1e-13     # event time tolerance [s]
+DRIVE_SUBSTEP = 2.5e-4   # a drive with play is checked for contact and separation this often [s]
+NO_DRIVE = (0.0, 0.0)    # (play [m], motor-side mass [kg]): a rigid drive
 
 
 @compiled
@@ -198,6 +202,71 @@ def advance(pp, fp, ef, s, mode, voltage, dt, substep):
 
 
 @compiled
+def drive_contact_force(pp, fp, ef, mass, s, mode, voltage):
+    """Force [N] the motor side (mass [kg]) presses on the cart with while the two move together:
+    alpha V - beta x' - mass x'', x'' the acceleration of cart and motor side as one body (0 while
+    static friction holds the cart). Its sign against the side of contact says whether the motor
+    side stays in contact."""
+    a = 0.0
+    if mode[0] == 0.0:
+        a = rates((pp[0] + mass, pp[1], pp[2], pp[3], pp[4], pp[5]), fp, ef, s, voltage, mode[1])[2]
+    return motor_force(pp, voltage, s[2]) - mass * a
+
+
+@compiled
+def advance_drive(pp, fp, ef, s, mode, drive, voltage, dt, substep, gap, mass):
+    """:func:`advance` for a drive with play (backlash) between motor and cart.
+
+    Two-mass drive: the motor side (rotor and gears reflected to the rack, ``mass`` [kg]) takes
+    the motor force of eq. (2), the cart gets only what the contact passes on, across a play of
+    ``gap`` [m] (the encoder reads the cart). ``drive`` = (d [m], vb [m/s], side): d = motor side
+    minus cart within [-gap/2, gap/2], vb the motor side's speed, side +1 / -1 in contact pushing
+    forward / backward, 0 in the play. In contact the two move as one body (cart mass M + mass,
+    the motor force on it); the motor side leaves when :func:`drive_contact_force` changes sign
+    against the side. In the play the cart moves under friction and its other forces alone and
+    the motor side as :func:`plant.motor_side_free`; closing the play is a plastic impact
+    (:func:`plant.drive_impact`), located by linear interpolation of d within the step. Contact
+    and separation are checked every :data:`DRIVE_SUBSTEP` at most. Returns (state, mode, drive).
+    """
+    half = 0.5 * gap
+    joined = (pp[0] + mass, pp[1], pp[2], pp[3], pp[4], pp[5])
+    loose = (pp[0], pp[1], pp[2], pp[3], pp[4], 0.0)   # no motor force on the cart in the play
+    d, vb, side = drive
+    n = max(1, math.ceil(dt / min(substep, DRIVE_SUBSTEP) - 1e-9))
+    h = dt / n
+    for _ in range(n):
+        remaining = h
+        for _ in range(MAX_EVENTS):
+            if remaining <= 0.0:
+                break
+            if side != 0.0:
+                if side * drive_contact_force(pp, fp, ef, mass, s, mode, voltage) >= 0.0:
+                    s, mode = advance(joined, fp, ef, s, mode, voltage, remaining, remaining)
+                    vb, remaining = s[2], 0.0
+                    continue
+                side = 0.0
+            s1, mode1 = advance(loose, fp, ef, s, mode, 0.0, remaining, remaining)
+            dx, vb1 = motor_side_free(pp, mass, vb, voltage, remaining)
+            d1 = d + dx - (s1[0] - s[0])
+            if abs(d1) < half:
+                s, mode, d, vb, remaining = s1, mode1, d1, vb1, 0.0
+                continue
+            edge = math.copysign(half, d1)
+            tc = remaining * min(1.0, max(0.0, (edge - d) / (d1 - d)))
+            if tc > 0.0:
+                s, mode = advance(loose, fp, ef, s, mode, 0.0, tc, tc)
+                vb = motor_side_free(pp, mass, vb, voltage, tc)[1]
+            s = drive_impact(pp, mass, s, vb)
+            if s[2] != 0.0:
+                mode = (0.0, math.copysign(1.0, s[2]), mode[2] + 1.0)
+            d, vb, side, remaining = edge, s[2], math.copysign(1.0, edge), remaining - tc
+        if remaining > 0.0:   # guard (more than MAX_EVENTS contacts in one substep): finish it joined
+            s, mode = advance(joined, fp, ef, s, mode, voltage, remaining, remaining)
+            vb = s[2]
+    return s, mode, (d, vb, side)
+
+
+@compiled
 def friction_now(pp, fp, ef, s, mode, voltage):
     """Friction force on the cart in state ``s`` and ``mode`` [N] (static while stuck)."""
     if mode[0] != 0.0:
@@ -217,10 +286,13 @@ class Simulator:
         Largest RK4 step [s] (default 0.25 ms, four per 1 kHz sample).
     extra_force : (cogging [N], cogging period [m], asymmetry [N]), optional
         Forces on the cart the friction model does not know (:func:`plant.undeclared_force`).
+    drive : (play [m], motor-side mass [kg]), optional
+        A drive with play between motor and cart (:func:`advance_drive`); play 0 = rigid. The
+        motor side starts at rest in the middle of the play.
     """
 
     def __init__(self, model: CartPendulum, state0, substep: float = 2.5e-4,
-                 extra_force: tuple = NO_EXTRA_FORCE):
+                 extra_force: tuple = NO_EXTRA_FORCE, drive: tuple = NO_DRIVE):
         self.model = model
         s = [float(v) for v in state0][:model.n_states]
         self._s = tuple(s + [0.0] * (5 - len(s)))
@@ -229,6 +301,8 @@ class Simulator:
         self.substep = float(substep)
         self.extra_force = tuple(float(v) for v in extra_force)
         self._pp, self._fp = model.vector, model.friction.vector
+        self.drive = (float(drive[0]), float(drive[1]))
+        self._drive = (0.0, 0.0, 0.0)  # motor side minus cart [m], its speed [m/s], side of contact
 
     @property
     def state(self) -> list:
@@ -259,12 +333,24 @@ class Simulator:
         """Force static friction must cancel at rest [N] (with x' = 0)."""
         return held(self._pp, self.extra_force, (float(s[0]), float(s[1]), 0.0, float(s[3]), 0.0), voltage)
 
+    @property
+    def in_play(self) -> bool:
+        """True while the motor side of a drive with play is out of contact with the cart."""
+        return self.drive[0] > 0.0 and self._drive[2] == 0.0
+
     def friction_force(self, voltage: float) -> float:
-        """Friction force on the cart in the current state [N]."""
-        return friction_now(self._pp, self._fp, self.extra_force, self._s, self._mode, voltage)
+        """Friction force on the cart in the current state [N] (no motor force reaches a cart
+        whose drive is in its play)."""
+        return friction_now(self._pp, self._fp, self.extra_force, self._s, self._mode,
+                            0.0 if self.in_play else voltage)
 
     def step(self, voltage: float, dt: float) -> None:
         """Advance by ``dt`` [s] with the voltage held at ``voltage`` [V]."""
-        self._s, self._mode = advance(self._pp, self._fp, self.extra_force, self._s, self._mode,
-                                      float(voltage), float(dt), self.substep)
+        if self.drive[0] > 0.0:
+            self._s, self._mode, self._drive = advance_drive(
+                self._pp, self._fp, self.extra_force, self._s, self._mode, self._drive, float(voltage),
+                float(dt), self.substep, self.drive[0], self.drive[1])
+        else:
+            self._s, self._mode = advance(self._pp, self._fp, self.extra_force, self._s, self._mode,
+                                          float(voltage), float(dt), self.substep)
         self.t += dt

@@ -92,6 +92,8 @@ PLANT_TRUTH_FIELDS = {
     'saturation_V': Field('V', 0.0, 1e3, 'drive saturation (0 = none)'),
     'input_delay_s': Field('s', 0.0, 10.0, 'transport delay of the command'),
     'backlash_m': Field('m', 0.0, 1.0, 'play between cart and its encoder'),
+    'drive_backlash_m': Field('m', 0.0, 1.0, 'play between the motor side of the drive and the cart'),
+    'drive_mass_kg': Field('kg', 0.0, 100.0, 'motor side of the drive reflected to the rack (with a play)'),
     'bias_x_m': Field('m', -1.0, 1.0, 'cart sensor offset'),
     'bias_theta_rad': Field('rad', -1.0, 1.0, 'angle sensor offset'),
     'noise_x_m': Field('m', 0.0, 1.0, 'cart sensor noise (std)'),
