@@ -57,7 +57,7 @@ SCREEN_GAIN = 0.01       # an effect whose own parameters lower the estimation c
 TYPICAL = {'M': 0.5, 'm': 0.1, 'l': 0.1, 'alpha': 1.0, 'beta': 5.0, 'Fc': 0.3, 'Fs_excess': 0.3, 'eps': 2.0,
            'v_s': 0.05, 'dz': 0.1, 'u_max': 5.0, 'delay': 0.01, 'cog_a': 0.1, 'cog_b': 0.1, 'cog_period': 0.01,
            'asym': 0.2, 'asym_v': 1.0, 'F0': 0.1, 'theta_bias': 0.005, 'gap': 1e-3, 'drive_gap': 1e-3,
-           'drive_mass': 0.2}
+           'drive_mass': 0.2, 'drive_stiffness': 1e5, 'drive_damping': 20.0}
 
 
 class Problem:
@@ -291,8 +291,12 @@ def effect_starts(pr: Problem, model: Model, name: str) -> list[dict]:
         return [{'u_max': f * umax} for f in (0.5, 0.8)]
     if name == 'backlash':
         return [{'gap': g} for g in (3e-4, 1e-3, 3e-3)]
-    if name == 'drive_backlash':   # a motor side of a quarter of the cart (a rotor reflected through the gears)
-        return [{'drive_gap': g, 'drive_mass': 0.25 * model['M']} for g in (3e-4, 1e-3, 3e-3)]
+    if name == 'drive_backlash':   # a motor side of a quarter of the cart (a rotor reflected through the gears),
+        #                             a contact ringing at about 100 Hz, damping ratio 0.2
+        mass = 0.25 * model['M']
+        k = mass * (2 * math.pi * 100.0) ** 2
+        return [{'drive_gap': g, 'drive_mass': mass, 'drive_stiffness': k, 'drive_damping': 0.4 * math.sqrt(k * mass)}
+                for g in (3e-4, 1e-3, 3e-3)]
     if name == 'sensor_bias':
         return [{'theta_bias': float(np.mean(rec.theta)) if rec.theta is not None else 0.0}]
     return [{}]

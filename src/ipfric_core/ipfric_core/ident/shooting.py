@@ -148,12 +148,14 @@ def angle_windows(rec: Record) -> Windows:
 
 @numba.njit(cache=True)
 def drive_states(pp, gap, mass, t, u, motion):
-    """(d, vb, side) of a drive with play at every sample (the state of
-    :func:`~ipfric_core.physics.simulate.advance_drive`), estimated by running its motor side
-    along the measured cart: in the play as :func:`~ipfric_core.physics.plant.motor_side_free`
-    under the command ``u`` (after the input effects) while the cart moves as measured
-    (``motion``: speed, acceleration); at an edge of the play in contact, moving with the cart,
-    until the contact force alpha u - beta x' - mass x'' turns against that edge."""
+    """(d, vb, side) of a drive with play at every sample ((d, vb) is the state of
+    :func:`~ipfric_core.physics.simulate.advance_drive`; side +1 / -1 in contact pushing forward
+    / backward, 0 in the play), estimated by running its motor side along the measured cart: in
+    the play as :func:`~ipfric_core.physics.plant.motor_side_free` under the command ``u``
+    (after the input effects) while the cart moves as measured (``motion``: speed,
+    acceleration); at an edge of the play in contact (a stiff contact: its compression is
+    neglected), moving with the cart, until the contact force alpha u - beta x' - mass x''
+    turns against that edge."""
     n = len(t)
     out = np.empty((n, 3))
     half = 0.5 * gap
@@ -181,22 +183,21 @@ def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, drive0, t, 
     """Encoder readings (x, theta) predicted in every window, written into ``out`` (n, 2).
     Without a pendulum (pp's m = 0) the angle is held at 0; with ``forced`` (n, 2) rows, the
     angle and its rate are set to them (less the bias) after every sample. With a drive play
-    (``drive`` = (play [m], motor-side mass [kg]), play > 0) each window starts from the drive
-    state ``drive0`` (n_windows, 3) of :func:`drive_states`."""
+    (``drive`` as :func:`~ipfric_core.physics.simulate.advance_drive` takes it, play > 0) each
+    window starts from the drive state ``drive0`` (n_windows, 2+) of :func:`drive_states`."""
     pendulum = pp[1] > 0.0
     force = len(forced) > 0
     for w in numba.prange(len(start)):
         s = (state[w, 0], state[w, 1] - theta_bias, state[w, 2], state[w, 3], state[w, 4])
         mode = (held[w], 0.0, 0.0)
-        dr = (drive0[w, 0], drive0[w, 1], drive0[w, 2])
+        dr = (drive0[w, 0], drive0[w, 1])
         reading = s[0]
         k0 = start[w]
         out[k0, 0], out[k0, 1] = reading, s[1] + theta_bias
         for k in range(k0, stop[w] - 1):
             v = input_effects(u[k], deadzone, saturation)
             if drive[0] > 0.0:
-                s, mode, dr = advance_drive(pp, fp, ef, s, mode, dr, v, t[k + 1] - t[k], substep,
-                                            drive[0], drive[1])
+                s, mode, dr = advance_drive(pp, fp, ef, s, mode, dr, v, t[k + 1] - t[k], substep, drive)
             else:
                 s, mode = advance(pp, fp, ef, s, mode, v, t[k + 1] - t[k], substep)
             if force:
@@ -238,7 +239,7 @@ def predict(model, rec: Record, win: Windows) -> Prediction:
     """Replay ``rec``'s command through ``model`` (an :class:`ident.model.ModelVectors`)."""
     u = np.ascontiguousarray(delayed(rec.t, rec.u, model.delay), float)
     out = np.full((len(rec.t), 2), np.nan)
-    drive = (float(model.drive[0]), float(model.drive[1]))
+    drive = tuple(float(v) for v in model.drive)
     drive0 = (drive_states(model.pp, drive[0], drive[1], rec.t, inputs_through(u, model.deadzone, model.saturation),
                            win.motion)[win.start] if drive[0] > 0.0 else np.zeros((len(win), 3)))
     _shoot(model.pp, model.fp, model.ef, model.deadzone, model.saturation, model.gap, model.theta_bias,

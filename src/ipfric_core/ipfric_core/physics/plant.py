@@ -113,12 +113,13 @@ NO_EXTRA_FORCE = (0.0, 1.0, 0.0, 0.0)
 
 @compiled
 def motor_side_free(pp, mass: float, vb: float, voltage: float, h: float):
-    """Motor side of a drive with play, out of contact with the cart, over ``h`` [s].
+    """Motor side of a drive with play over ``h`` [s], ``voltage`` [V] held.
 
     The motor's rotor and gears reflected to the rack as a mass ``mass`` [kg] driven by the
-    motor force of eq. (2) on its own speed: mass vb' = alpha V - beta vb. Exact solution:
-    it tends to alpha V / beta [m/s] with time constant mass / beta [s] (at once for a
-    massless motor side). Returns (displacement [m], final speed vb [m/s]).
+    motor force of eq. (2) on its own speed: mass vb' = alpha V - beta vb (a contact force F
+    held over the step enters as V - F / alpha). Exact solution: it tends to alpha V / beta
+    [m/s] with time constant mass / beta [s] (at once for a massless motor side). Returns
+    (displacement [m], final speed vb [m/s]).
     """
     alpha, beta = pp[ALPHA], pp[BETA]
     if beta <= 0.0:
@@ -135,18 +136,18 @@ def motor_side_free(pp, mass: float, vb: float, voltage: float, h: float):
 
 
 @compiled
-def drive_impact(pp, mass: float, s, vb: float):
-    """State ``s`` of the cart after the motor side (mass [kg], speed vb [m/s]) closes the play.
-
-    A plastic impact (a stiff contact that does not bounce: the two move on together): the
-    impulse J on the cart changes x' by J / m_e, m_e = M + m - 3/4 m cos^2(theta) its
-    effective mass with the pendulum hinged (eq. 16), and theta' by -3/4 cos(theta) dx' / l
-    (the pendulum's equation integrated over the impulse); momentum m_e x' + mass vb is kept.
-    """
-    c = math.cos(s[1])
-    me = pp[M] + pp[MP] - 0.75 * pp[MP] * c * c
-    dv = (me * s[2] + mass * vb) / (me + mass) - s[2]
-    return (s[0], s[1], s[2] + dv, s[3] - 0.75 * c * dv / pp[L], s[4])
+def drive_contact_force(dp, d: float, dv: float) -> float:
+    """Force [N] on the cart from the motor side of a drive with play, ``dp`` = (play [m], motor-side
+    mass [kg], contact stiffness k [N/m], contact damping c [N s/m]), d = motor side minus cart [m],
+    dv its speed relative to the cart [m/s]: k (d -/+ play/2) + c dv beyond either edge of the play
+    (a stiff contact, the usual dead-zone model of a two-mass drive), 0 inside it. A contact only
+    pushes: the force never pulls the two together."""
+    half = 0.5 * dp[0]
+    if d > half:
+        return max(dp[2] * (d - half) + dp[3] * dv, 0.0)
+    if d < -half:
+        return min(dp[2] * (d + half) + dp[3] * dv, 0.0)
+    return 0.0
 
 
 @compiled

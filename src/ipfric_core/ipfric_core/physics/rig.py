@@ -37,9 +37,10 @@ class PlantTruth:
     backlash_m : play between cart and its position encoder (rack and pinion) [m]
     drive_backlash_m : play between the motor side of the drive and the cart [m]; the motor
         side (rotor and gears reflected to the rack) crosses it without pushing the cart
-        (two-mass drive, ``simulate.advance_drive``)
-    drive_mass_kg : that motor side's mass reflected to the rack [kg] (0 = massless: in the play
-        it moves at alpha V / beta at once)
+        (two-mass drive, ``simulate.advance_drive``); with it:
+    drive_mass_kg : that motor side's mass reflected to the rack [kg], > 0
+    drive_stiffness_N_per_m, drive_damping_Ns_per_m : its contact with the cart beyond the play,
+        k [N/m] > 0 and c [N s/m] (``plant.drive_contact_force``)
     bias_x_m, bias_theta_rad : constant sensor offsets [m], [rad]
     noise_x_m, noise_theta_rad : standard deviation of Gaussian sensor noise [m], [rad]
     noise_seed : seed of that noise
@@ -57,6 +58,8 @@ class PlantTruth:
     backlash_m: float = 0.0
     drive_backlash_m: float = 0.0
     drive_mass_kg: float = 0.0
+    drive_stiffness_N_per_m: float = 0.0
+    drive_damping_Ns_per_m: float = 0.0
     bias_x_m: float = 0.0
     bias_theta_rad: float = 0.0
     noise_x_m: float = 0.0
@@ -72,8 +75,10 @@ class PlantTruth:
                 float(self.offset_N))
 
     def drive_vector(self) -> tuple:
-        """(play [m], motor-side mass [kg]) of the drive as ``simulate.advance_drive`` takes them."""
-        return (float(self.drive_backlash_m), float(self.drive_mass_kg))
+        """(play [m], motor-side mass [kg], contact stiffness [N/m], damping [N s/m]) of the drive, as
+        ``simulate.advance_drive`` takes them."""
+        return (float(self.drive_backlash_m), float(self.drive_mass_kg), float(self.drive_stiffness_N_per_m),
+                float(self.drive_damping_Ns_per_m))
 
     def true_friction(self, friction: FrictionParams) -> FrictionParams:
         """The declared friction law with the rig's direction dependence added."""

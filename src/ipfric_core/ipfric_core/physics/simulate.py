@@ -28,7 +28,7 @@ from .friction import friction_force, holding_margin, holds, sticks
 from .plant import (
     NO_EXTRA_FORCE,
     CartPendulum,
-    drive_impact,
+    drive_contact_force,
     held_force,
     motor_force,
     motor_side_free,
@@ -39,8 +39,8 @@ from .plant import (
 
 MAX_EVENTS = 64  # per substep; a guard, never reached in normal motion
 XTOL = 1e-13     # event time tolerance [s]
-DRIVE_SUBSTEP = 2.5e-4   # a drive with play is checked for contact and separation this often [s]
-NO_DRIVE = (0.0, 0.0)    # (play [m], motor-side mass [kg]): a rigid drive
+CONTACT_STEPS = 40       # steps per period of the drive's contact oscillation
+NO_DRIVE = (0.0, 0.0, 0.0, 0.0)   # (play [m], motor-side mass [kg], stiffness [N/m], damping [N s/m]): rigid
 
 
 @compiled
@@ -202,68 +202,41 @@ def advance(pp, fp, ef, s, mode, voltage, dt, substep):
 
 
 @compiled
-def drive_contact_force(pp, fp, ef, mass, s, mode, voltage):
-    """Force [N] the motor side (mass [kg]) presses on the cart with while the two move together:
-    alpha V - beta x' - mass x'', x'' the acceleration of cart and motor side as one body (0 while
-    static friction holds the cart). Its sign against the side of contact says whether the motor
-    side stays in contact."""
-    a = 0.0
-    if mode[0] == 0.0:
-        a = rates((pp[0] + mass, pp[1], pp[2], pp[3], pp[4], pp[5]), fp, ef, s, voltage, mode[1])[2]
-    return motor_force(pp, voltage, s[2]) - mass * a
+def drive_step(dp, mass_cart: float, substep: float) -> float:
+    """Largest step [s] of :func:`advance_drive`: ``substep``, and CONTACT_STEPS per period of the
+    contact oscillation 2 pi sqrt(m_r / k) of the motor side (mass dp[1]) against the cart
+    (``mass_cart``), m_r their reduced mass."""
+    reduced = dp[1] * mass_cart / (dp[1] + mass_cart)
+    return min(substep, 2.0 * math.pi * math.sqrt(reduced / dp[2]) / CONTACT_STEPS)
 
 
 @compiled
-def advance_drive(pp, fp, ef, s, mode, drive, voltage, dt, substep, gap, mass):
+def advance_drive(pp, fp, ef, s, mode, drive, voltage, dt, substep, dp):
     """:func:`advance` for a drive with play (backlash) between motor and cart.
 
-    Two-mass drive: the motor side (rotor and gears reflected to the rack, ``mass`` [kg]) takes
-    the motor force of eq. (2), the cart gets only what the contact passes on, across a play of
-    ``gap`` [m] (the encoder reads the cart). ``drive`` = (d [m], vb [m/s], side): d = motor side
-    minus cart within [-gap/2, gap/2], vb the motor side's speed, side +1 / -1 in contact pushing
-    forward / backward, 0 in the play. In contact the two move as one body (cart mass M + mass,
-    the motor force on it); the motor side leaves when :func:`drive_contact_force` changes sign
-    against the side. In the play the cart moves under friction and its other forces alone and
-    the motor side as :func:`plant.motor_side_free`; closing the play is a plastic impact
-    (:func:`plant.drive_impact`), located by linear interpolation of d within the step. Contact
-    and separation are checked every :data:`DRIVE_SUBSTEP` at most. Returns (state, mode, drive).
+    Two-mass drive, ``dp`` = (play [m], motor-side mass [kg], contact stiffness [N/m], contact
+    damping [N s/m]): the motor side (rotor and gears reflected to the rack) takes the motor force
+    of eq. (2) (:func:`plant.motor_side_free`); the cart gets only the contact force
+    :func:`plant.drive_contact_force` (none inside the play) besides friction and its other
+    forces; the encoder reads the cart. ``drive`` = (d [m], vb [m/s]): motor side minus cart, and
+    the motor side's speed. Each step (:func:`drive_step`) holds the contact force at the mean of
+    its values at the start and at the end of a first pass (Heun), the cart advancing by
+    :func:`advance` (exact stick-slip) and the motor side exactly. Returns (state, mode, drive).
     """
-    half = 0.5 * gap
-    joined = (pp[0] + mass, pp[1], pp[2], pp[3], pp[4], pp[5])
-    loose = (pp[0], pp[1], pp[2], pp[3], pp[4], 0.0)   # no motor force on the cart in the play
-    d, vb, side = drive
-    n = max(1, math.ceil(dt / min(substep, DRIVE_SUBSTEP) - 1e-9))
+    on_cart = (pp[0], pp[1], pp[2], pp[3], 1.0, 0.0)   # the "voltage" is then the force on the cart [N]
+    d, vb = drive
+    n = max(1, math.ceil(dt / drive_step(dp, pp[0], substep) - 1e-9))
     h = dt / n
     for _ in range(n):
-        remaining = h
-        for _ in range(MAX_EVENTS):
-            if remaining <= 0.0:
-                break
-            if side != 0.0:
-                if side * drive_contact_force(pp, fp, ef, mass, s, mode, voltage) >= 0.0:
-                    s, mode = advance(joined, fp, ef, s, mode, voltage, remaining, remaining)
-                    vb, remaining = s[2], 0.0
-                    continue
-                side = 0.0
-            s1, mode1 = advance(loose, fp, ef, s, mode, 0.0, remaining, remaining)
-            dx, vb1 = motor_side_free(pp, mass, vb, voltage, remaining)
-            d1 = d + dx - (s1[0] - s[0])
-            if abs(d1) < half:
-                s, mode, d, vb, remaining = s1, mode1, d1, vb1, 0.0
-                continue
-            edge = math.copysign(half, d1)
-            tc = remaining * min(1.0, max(0.0, (edge - d) / (d1 - d)))
-            if tc > 0.0:
-                s, mode = advance(loose, fp, ef, s, mode, 0.0, tc, tc)
-                vb = motor_side_free(pp, mass, vb, voltage, tc)[1]
-            s = drive_impact(pp, mass, s, vb)
-            if s[2] != 0.0:
-                mode = (0.0, math.copysign(1.0, s[2]), mode[2] + 1.0)
-            d, vb, side, remaining = edge, s[2], math.copysign(1.0, edge), remaining - tc
-        if remaining > 0.0:   # guard (more than MAX_EVENTS contacts in one substep): finish it joined
-            s, mode = advance(joined, fp, ef, s, mode, voltage, remaining, remaining)
-            vb = s[2]
-    return s, mode, (d, vb, side)
+        f0 = drive_contact_force(dp, d, vb - s[2])
+        s1, _m = advance(on_cart, fp, ef, s, mode, f0, h, h)
+        dx, v1 = motor_side_free(pp, dp[1], vb, voltage - f0 / pp[4], h)
+        f = 0.5 * (f0 + drive_contact_force(dp, d + dx - (s1[0] - s[0]), v1 - s1[2]))
+        s1, mode = advance(on_cart, fp, ef, s, mode, f, h, h)
+        dx, vb = motor_side_free(pp, dp[1], vb, voltage - f / pp[4], h)
+        d += dx - (s1[0] - s[0])
+        s = s1
+    return s, mode, (d, vb)
 
 
 @compiled
@@ -286,7 +259,7 @@ class Simulator:
         Largest RK4 step [s] (default 0.25 ms, four per 1 kHz sample).
     extra_force : (cogging [N], cogging period [m], asymmetry [N]), optional
         Forces on the cart the friction model does not know (:func:`plant.undeclared_force`).
-    drive : (play [m], motor-side mass [kg]), optional
+    drive : (play [m], motor-side mass [kg], contact stiffness [N/m], contact damping [N s/m]), optional
         A drive with play between motor and cart (:func:`advance_drive`); play 0 = rigid. The
         motor side starts at rest in the middle of the play.
     """
@@ -301,8 +274,8 @@ class Simulator:
         self.substep = float(substep)
         self.extra_force = tuple(float(v) for v in extra_force)
         self._pp, self._fp = model.vector, model.friction.vector
-        self.drive = (float(drive[0]), float(drive[1]))
-        self._drive = (0.0, 0.0, 0.0)  # motor side minus cart [m], its speed [m/s], side of contact
+        self.drive = tuple(float(v) for v in drive)
+        self._drive = (0.0, 0.0)  # motor side minus cart [m], its speed [m/s]
 
     @property
     def state(self) -> list:
@@ -333,23 +306,22 @@ class Simulator:
         """Force static friction must cancel at rest [N] (with x' = 0)."""
         return held(self._pp, self.extra_force, (float(s[0]), float(s[1]), 0.0, float(s[3]), 0.0), voltage)
 
-    @property
-    def in_play(self) -> bool:
-        """True while the motor side of a drive with play is out of contact with the cart."""
-        return self.drive[0] > 0.0 and self._drive[2] == 0.0
-
     def friction_force(self, voltage: float) -> float:
-        """Friction force on the cart in the current state [N] (no motor force reaches a cart
-        whose drive is in its play)."""
-        return friction_now(self._pp, self._fp, self.extra_force, self._s, self._mode,
-                            0.0 if self.in_play else voltage)
+        """Friction force on the cart in the current state [N]; with a drive with play, the force
+        of its contact (:func:`plant.drive_contact_force`) takes the motor force's place."""
+        if self.drive[0] > 0.0:
+            d, vb = self._drive
+            pp = self._pp
+            return friction_now((pp[0], pp[1], pp[2], pp[3], 1.0, 0.0), self._fp, self.extra_force, self._s,
+                                self._mode, drive_contact_force(self.drive, d, vb - self._s[2]))
+        return friction_now(self._pp, self._fp, self.extra_force, self._s, self._mode, voltage)
 
     def step(self, voltage: float, dt: float) -> None:
         """Advance by ``dt`` [s] with the voltage held at ``voltage`` [V]."""
         if self.drive[0] > 0.0:
             self._s, self._mode, self._drive = advance_drive(
                 self._pp, self._fp, self.extra_force, self._s, self._mode, self._drive, float(voltage),
-                float(dt), self.substep, self.drive[0], self.drive[1])
+                float(dt), self.substep, self.drive)
         else:
             self._s, self._mode = advance(self._pp, self._fp, self.extra_force, self._s, self._mode,
                                           float(voltage), float(dt), self.substep)
