@@ -276,8 +276,9 @@ def unresolved(model: Model, std: dict, name: str) -> list[str]:
     return []
 
 
-def effect_starts(pr: Problem, model: Model, name: str) -> list[dict]:
-    """Start values of effect ``name`` (several where the fit has several minima)."""
+def effect_starts(pr: Problem, model: Model, name: str, prior: Model) -> list[dict]:
+    """Start values of effect ``name`` (several where the fit has several minima); a start may
+    also name other parameters of ``model`` (``prior``: the declared model)."""
     rec = pr.rec
     if name == 'cogging':
         return [{'cog_period': p} for p in (0.002, 0.0035, 0.006, 0.01, 0.015, 0.02)]
@@ -291,15 +292,37 @@ def effect_starts(pr: Problem, model: Model, name: str) -> list[dict]:
         return [{'u_max': f * umax} for f in (0.5, 0.8)]
     if name == 'backlash':
         return [{'gap': g} for g in (3e-4, 1e-3, 3e-3)]
-    if name == 'drive_backlash':   # a motor side of a quarter of the cart (a rotor reflected through the gears),
-        #                             a contact ringing at about 100 Hz, damping ratio 0.2
-        mass = 0.25 * model['M']
-        k = mass * (2 * math.pi * 100.0) ** 2
-        return [{'drive_gap': g, 'drive_mass': mass, 'drive_stiffness': k, 'drive_damping': 0.4 * math.sqrt(k * mass)}
-                for g in (3e-4, 1e-3, 3e-3)]
+    if name == 'drive_backlash':
+        return drive_starts(pr, model, prior)
     if name == 'sensor_bias':
         return [{'theta_bias': float(np.mean(rec.theta)) if rec.theta is not None else 0.0}]
     return [{}]
+
+
+#: the grid :func:`drive_starts` evaluates: plays [m], motor-side masses [share of M], contact
+#: frequencies [Hz] (the contact's stiffness k = m_r (2 pi f)^2, m_r the reduced mass), and the
+#: contact's damping ratio
+DRIVE_GRID = ((2e-4, 5e-4, 1e-3, 2e-3, 4e-3), (0.1, 0.25, 0.5), (50.0, 100.0, 200.0, 400.0), 0.15)
+
+
+def drive_starts(pr: Problem, model: Model, prior: Model, keep: int = 2) -> list[dict]:
+    """Start values of a drive with play: the ``keep`` best points of :data:`DRIVE_GRID` by the
+    estimation error (its error has many local minima: each contact frequency rings differently),
+    with the friction of the declared model ``prior`` (a refit without the play distorts it: the
+    Coulomb level sinks where the cart coasts through the play)."""
+    gaps, shares, freqs, zeta = DRIVE_GRID
+    law = {p.name: p.value for p in prior.free}
+    model = model.with_values(law)
+    grid = []
+    for share in shares:
+        mass = share * model['M']
+        reduced = mass * model['M'] / (mass + model['M'])
+        for f in freqs:
+            k = reduced * (2 * math.pi * f) ** 2
+            grid += [{'drive_gap': g, 'drive_mass': mass, 'drive_stiffness': k,
+                      'drive_damping': 2 * zeta * math.sqrt(k * reduced), **law} for g in gaps]
+    costs = [pr.cost(model.with_effect('drive_backlash', p)) for p in grid]
+    return [grid[i] for i in np.argsort(costs)[:keep]]
 
 
 def candidate(pe: Problem, current: Model, name: str, prior: Model) -> tuple[Model, dict]:
@@ -309,8 +332,8 @@ def candidate(pe: Problem, current: Model, name: str, prior: Model) -> tuple[Mod
     own = {s.name for s in EFFECTS[name].params}
     levels = {p.name for p in current.free} & {'Fc', 'Fs_excess'}
     screen = (own - {'cog_period'}) | levels
-    fits = [fit_model(pe, current.with_effect(name, s), max_nfev=12, only=screen, prior=prior)[0]
-            for s in effect_starts(pe, current, name)]
+    fits = [fit_model(pe, current.with_effect(name, s).with_values(s), max_nfev=12, only=screen, prior=prior)[0]
+            for s in effect_starts(pe, current, name, prior)]
     costs = [pe.cost(m) for m in fits]
     best = fits[int(np.argmin(costs))]
     if min(costs) > (1 - SCREEN_GAIN) * pe.cost(current):
