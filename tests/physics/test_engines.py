@@ -70,6 +70,16 @@ def test_noise_needs_the_python_engine():
         run_closed_loop(rig, s.make_controller(), 0.1, engine='compiled')
 
 
+def test_a_drive_with_play_needs_the_python_engine():
+    s = replace(scenario('fig7_old_gain_exponential'),
+                truth=PlantTruth(drive_backlash_m=5e-4, drive_mass_kg=0.2, drive_stiffness_N_per_m=2e5))
+    with pytest.raises(ValueError, match='drive with play'):
+        run_closed_loop(s.make_rig(), s.make_controller(), 0.1, engine='compiled')
+    auto = run_closed_loop(s.make_rig(), s.make_controller(), 0.1)       # falls back to python
+    py = run_closed_loop(s.make_rig(), s.make_controller(), 0.1, engine='python')
+    np.testing.assert_array_equal(auto.measured, py.measured)
+
+
 def test_rig_and_controller_hand_over_their_settings_as_frozen_specs():
     s = replace(scenario('delay_exponential_tau20ms'), truth=EFFECTS)
     rig, ctl = s.make_rig(), s.make_controller()

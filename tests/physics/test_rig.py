@@ -4,7 +4,7 @@ import math
 import pytest
 
 from ipfric_core.physics.params import ConfigError, FrictionParams, PlantParams
-from ipfric_core.physics.plant import CartPendulum
+from ipfric_core.physics.plant import CartPendulum, drive_contact_force
 from ipfric_core.physics.rig import PlantTruth, Rig, apply_input_effects, play
 from ipfric_core.run.scenario import Scenario, load_scenario, nest, scenario_from_ros_params
 
@@ -66,6 +66,40 @@ def test_backlash_play_and_sensor_bias_noise():
     a = rig(PlantTruth(noise_theta_rad=1e-3, noise_seed=7), theta0=0.0)
     b = rig(PlantTruth(noise_theta_rad=1e-3, noise_seed=7), theta0=0.0)
     assert [a.measure() for _ in range(3)] == [b.measure() for _ in range(3)]
+
+
+def test_drive_play_keeps_the_motor_force_off_the_cart_until_the_motor_side_crosses_it():
+    """1 V (1.72 N, twice the breakaway force) through a 1 mm play: the motor side (0.2 kg, speed
+    tending to alpha V / beta = 0.224 m/s with time constant 0.2 / 7.682 = 26 ms) starts in the
+    middle and crosses half the play in about sqrt(2 * 0.026 s * 0.5 mm / 0.224 m/s) = 11 ms;
+    until then nothing reaches the cart (held with no force). Then the cart moves, behind a
+    rigid drive (its knock and the motor side's inertia)."""
+    truth = PlantTruth(drive_backlash_m=1e-3, drive_mass_kg=0.2, drive_stiffness_N_per_m=2e5,
+                       drive_damping_Ns_per_m=50.0)
+    r, rigid = rig(truth), rig(PlantTruth())
+    for _ in range(10):
+        r.step(1.0)
+        rigid.step(1.0)
+    assert r.truth()['x'] == 0.0 and r.truth()['stuck'] and abs(r.truth()['friction_force']) < 1e-9
+    assert rigid.truth()['x'] > 4e-5
+    for _ in range(50):
+        r.step(1.0)
+        rigid.step(1.0)
+    assert 0.9 * rigid.truth()['x'] < r.truth()['x'] < rigid.truth()['x'] - 2e-5
+
+
+def test_drive_contact_pushes_beyond_the_play_and_never_pulls():
+    dp = (1e-3, 0.2, 2e5, 50.0)
+    assert drive_contact_force(dp, 4e-4, 1.0) == 0.0                           # inside the play
+    assert drive_contact_force(dp, 6e-4, 0.01) == pytest.approx(2e5 * 1e-4 + 0.5)
+    assert drive_contact_force(dp, -6e-4, -0.01) == pytest.approx(-(2e5 * 1e-4 + 0.5))
+    assert drive_contact_force(dp, 6e-4, -1.0) == 0.0                          # leaving fast: no pull
+
+
+def test_a_drive_play_needs_its_motor_side_and_contact():
+    bad = dict(SIM, plant_truth={'drive_backlash_m': 1e-3, 'drive_stiffness_N_per_m': 2e5})
+    with pytest.raises(ConfigError, match='plant_truth.drive_mass_kg'):
+        scenario_from_ros_params(bad, CTRL)
 
 
 def test_encoder_quantization_in_the_rig():

@@ -6,7 +6,8 @@ The identified force balance of the cart (paper eq. 1 with the motor force 2) is
 
 u_eff is the input after the input effects (deadzone, saturation, delay); R holds the
 friction and the other forces (coulomb, stribeck, presliding, asymmetry, offset,
-cogging); backlash and sensor_bias act on the measurements. Every effect has named
+cogging); drive_backlash cuts the drive from the cart within a play; backlash and
+sensor_bias act on the measurements. Every effect has named
 parameters with units and bounds, and names the residual signature that points to it
 (a variable of :mod:`ipfric_core.ident.residual`).
 """
@@ -39,7 +40,7 @@ class Effect:
 
     name: str
     params: tuple
-    acts_on: str          # 'friction', 'force', 'input' or 'sensor'
+    acts_on: str          # 'friction', 'force', 'input', 'drive' or 'sensor'
     signature: str        # key of residual.SIGNATURES
     doc: str
     requires: tuple = ()
@@ -72,6 +73,13 @@ EFFECTS = {e.name: e for e in (
     Effect('backlash', (ParamSpec('gap', 'm', 0.0, 0.05),), 'sensor', 'reversal',
            'play of width gap between cart and encoder: the measured position dwells at each '
            'reversal while the cart moves gap; spikes of residual right after reversals'),
+    Effect('drive_backlash', (ParamSpec('drive_gap', 'm', 0.0, 0.05), ParamSpec('drive_mass', 'kg', 1e-3, 10.0, None),
+                              ParamSpec('drive_stiffness', 'N/m', 1e3, 1e6, None),
+                              ParamSpec('drive_damping', 'N s/m', 0.0, 1e3, None)), 'drive', 'reversal',
+           'play of width drive_gap between the motor side of the drive (mass drive_mass reflected to '
+           'the rack) and the cart, the encoder on the cart, a stiff contact beyond it '
+           '(physics.simulate.advance_drive): at a reversal of the drive force the cart coasts while '
+           'the motor side crosses the play, then takes a knock'),
     Effect('deadzone', (ParamSpec('dz', 'input unit', 0.0, 1e3, None),), 'input', 'voltage',
            'input deadzone: |u| < dz gives no force, beyond it u - sgn(u) dz; the residual is an odd '
            'step in u'),

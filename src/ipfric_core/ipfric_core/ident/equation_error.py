@@ -331,7 +331,10 @@ def explained(pr: Prepared, f: Fit) -> bool:
 
 
 def candidate_names(pr: Prepared, base: tuple, allowed=None) -> list[str]:
-    names = [n for n in fx.EFFECTS if n not in base and (allowed is None or n in allowed)]
+    """The effects this search can fit: a drive with play has a hidden state (the motor side
+    within the play) that a force balance on measured signals cannot express."""
+    names = [n for n in fx.EFFECTS if n not in base and (allowed is None or n in allowed)
+             and fx.EFFECTS[n].acts_on != 'drive']
     return [n for n in names if pr.has_theta or not fx.EFFECTS[n].needs_theta]
 
 

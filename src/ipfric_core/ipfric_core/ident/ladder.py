@@ -16,7 +16,8 @@ hypothesis. The ladder, on one metric (the multiple-shooting simulation error of
 - no fitted parameter ends on a bound;
 - the data do not contradict it: a deadzone below the smallest command that moved the
   cart, a saturation that no steady speed above it refutes, a delay no longer than the
-  lag at which the cart answers the command.
+  lag at which the cart answers the command, a play of at least two encoder counts, a drive
+  play that the motor side crosses at three reversals at least, in two samples or more.
 
 Fits are bounded least squares (``scipy.optimize.least_squares``) on parameters scaled to
 their typical size, with a finite-difference Jacobian; standard errors come from it,
@@ -32,6 +33,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..physics.params import ConfigError
+from ..physics.rig import inputs_through
 from . import shooting
 from .effects import EFFECTS
 from .equation_error import BOOTSTRAP, P_VALUE
@@ -50,11 +52,15 @@ PRIOR_COUNTS = 0.3      # RMS error [counts] that one prior standard deviation i
 REFIT_NOTE = 0.3         # a refit that moves a declared value by more than 30 % is reported
 STOP_S = 0.05            # a stretch this long with the encoder still is a stop [s]
 SCREEN_GAIN = 0.01       # an effect whose own parameters lower the estimation cost less is not refitted
+#: effects started from a grid of their error: when its best point lowers the estimation cost by less
+#: than SCREEN_GAIN, they are not fitted (a drive play's simulation costs tens of ordinary ones)
+GRID_SCREENED = ('drive_backlash',)
 
 #: typical size of each parameter (the fit works on value / size)
 TYPICAL = {'M': 0.5, 'm': 0.1, 'l': 0.1, 'alpha': 1.0, 'beta': 5.0, 'Fc': 0.3, 'Fs_excess': 0.3, 'eps': 2.0,
            'v_s': 0.05, 'dz': 0.1, 'u_max': 5.0, 'delay': 0.01, 'cog_a': 0.1, 'cog_b': 0.1, 'cog_period': 0.01,
-           'asym': 0.2, 'asym_v': 1.0, 'F0': 0.1, 'theta_bias': 0.005, 'gap': 1e-3}
+           'asym': 0.2, 'asym_v': 1.0, 'F0': 0.1, 'theta_bias': 0.005, 'gap': 1e-3, 'drive_gap': 1e-3,
+           'drive_mass': 0.2, 'drive_stiffness': 1e5, 'drive_damping': 20.0}
 
 
 class Problem:
@@ -196,6 +202,22 @@ def response_lag(rec: Record, max_lag: float = 0.1) -> float:
     return int(np.argmax(cc)) * rec.dt
 
 
+def drive_crossings(pr: Problem, model: Model) -> np.ndarray:
+    """Durations [s] of the model's motor side crossing its whole play (from contact on one side
+    to contact on the other: a reversal of the drive force), run along ``pr``'s record
+    (:func:`shooting.drive_states`)."""
+    rec, vec = pr.rec, model.vectors()
+    u = shooting.delayed(rec.t, rec.u, vec.delay)
+    u = inputs_through(np.ascontiguousarray(u, float), vec.deadzone, vec.saturation)
+    side = shooting.drive_states(vec.pp, vec.drive[0], vec.drive[1], rec.t, u, pr.blocks[0][1].motion)[:, 2]
+    touch = np.flatnonzero(side != 0.0)
+    if len(touch) < 2:
+        return np.zeros(0)
+    before, after = touch[:-1], touch[1:]
+    across = side[before] != side[after]
+    return rec.t[after[across]] - rec.t[before[across]]
+
+
 def contradictions(pr: Problem, model: Model, name: str) -> list[str]:
     """Why the data refute the fitted effect ``name`` (empty when nothing does)."""
     rec = pr.rec
@@ -225,12 +247,22 @@ def contradictions(pr: Problem, model: Model, name: str) -> list[str]:
                    f'({np.ptp(rec.x) * 1e3:.3g} mm)')
     if name == 'backlash' and model['gap'] < 2 * rec.x_resolution:
         why.append(f'play {model["gap"] * 1e3:.3g} mm is below two encoder counts (quantization)')
+    if name == 'drive_backlash':
+        if model['drive_gap'] < 2 * rec.x_resolution:
+            why.append(f'drive play {model["drive_gap"] * 1e3:.3g} mm is below two encoder counts (quantization)')
+        crossings = drive_crossings(pr, model)
+        if len(crossings) < 3:
+            why.append(f'the motor side crosses its play at {len(crossings)} reversals of the drive force '
+                       f'(needs 3)')
+        elif np.median(crossings) < 2 * rec.dt:
+            why.append(f'the motor side crosses its play in {np.median(crossings) * 1e3:.3g} ms (median over '
+                       f'{len(crossings)} reversals), under two samples: the data cannot show it')
     return why
 
 
 #: the parameters that give an effect its size (zero = no effect)
 SIZE = {'deadzone': ('dz',), 'delay': ('delay',), 'cogging': ('cog_a', 'cog_b'), 'asymmetry': ('asym', 'asym_v'),
-        'offset': ('F0',), 'sensor_bias': ('theta_bias',), 'backlash': ('gap',)}
+        'offset': ('F0',), 'sensor_bias': ('theta_bias',), 'backlash': ('gap',), 'drive_backlash': ('drive_gap',)}
 
 
 def unresolved(model: Model, std: dict, name: str) -> list[str]:
@@ -247,8 +279,9 @@ def unresolved(model: Model, std: dict, name: str) -> list[str]:
     return []
 
 
-def effect_starts(pr: Problem, model: Model, name: str) -> list[dict]:
-    """Start values of effect ``name`` (several where the fit has several minima)."""
+def effect_starts(pr: Problem, model: Model, name: str, prior: Model) -> list[dict]:
+    """Start values of effect ``name`` (several where the fit has several minima); a start may
+    also name other parameters of ``model`` (``prior``: the declared model)."""
     rec = pr.rec
     if name == 'cogging':
         return [{'cog_period': p} for p in (0.002, 0.0035, 0.006, 0.01, 0.015, 0.02)]
@@ -262,9 +295,37 @@ def effect_starts(pr: Problem, model: Model, name: str) -> list[dict]:
         return [{'u_max': f * umax} for f in (0.5, 0.8)]
     if name == 'backlash':
         return [{'gap': g} for g in (3e-4, 1e-3, 3e-3)]
+    if name == 'drive_backlash':
+        return drive_starts(pr, model, prior)
     if name == 'sensor_bias':
         return [{'theta_bias': float(np.mean(rec.theta)) if rec.theta is not None else 0.0}]
     return [{}]
+
+
+#: the grid :func:`drive_starts` evaluates: plays [m], motor-side masses [share of M], contact
+#: frequencies [Hz] (the contact's stiffness k = m_r (2 pi f)^2, m_r the reduced mass), and the
+#: contact's damping ratio
+DRIVE_GRID = ((2e-4, 5e-4, 1e-3, 2e-3, 4e-3), (0.1, 0.25, 0.5), (50.0, 100.0, 200.0, 400.0), 0.15)
+
+
+def drive_starts(pr: Problem, model: Model, prior: Model, keep: int = 2) -> list[dict]:
+    """Start values of a drive with play: the ``keep`` best points of :data:`DRIVE_GRID` by the
+    estimation error (its error has many local minima: each contact frequency rings differently),
+    with the friction of the declared model ``prior`` (a refit without the play distorts it: the
+    Coulomb level sinks where the cart coasts through the play)."""
+    gaps, shares, freqs, zeta = DRIVE_GRID
+    law = {p.name: p.value for p in prior.free}
+    model = model.with_values(law)
+    grid = []
+    for share in shares:
+        mass = share * model['M']
+        reduced = mass * model['M'] / (mass + model['M'])
+        for f in freqs:
+            k = reduced * (2 * math.pi * f) ** 2
+            grid += [{'drive_gap': g, 'drive_mass': mass, 'drive_stiffness': k,
+                      'drive_damping': 2 * zeta * math.sqrt(k * reduced), **law} for g in gaps]
+    costs = [pr.cost(model.with_effect('drive_backlash', p).with_values(p)) for p in grid]
+    return [grid[i] for i in np.argsort(costs)[:keep]]
 
 
 def candidate(pe: Problem, current: Model, name: str, prior: Model) -> tuple[Model, dict]:
@@ -274,8 +335,12 @@ def candidate(pe: Problem, current: Model, name: str, prior: Model) -> tuple[Mod
     own = {s.name for s in EFFECTS[name].params}
     levels = {p.name for p in current.free} & {'Fc', 'Fs_excess'}
     screen = (own - {'cog_period'}) | levels
-    fits = [fit_model(pe, current.with_effect(name, s), max_nfev=12, only=screen, prior=prior)[0]
-            for s in effect_starts(pe, current, name)]
+    starts = [current.with_effect(name, s).with_values(s) for s in effect_starts(pe, current, name, prior)]
+    if name in GRID_SCREENED:
+        costs = [pe.cost(m) for m in starts]
+        if min(costs) > (1 - SCREEN_GAIN) * pe.cost(current):
+            return starts[int(np.argmin(costs))], {}   # the best of a grid explains nothing: not fitted
+    fits = [fit_model(pe, m, max_nfev=12, only=screen, prior=prior)[0] for m in starts]
     costs = [pe.cost(m) for m in fits]
     best = fits[int(np.argmin(costs))]
     if min(costs) > (1 - SCREEN_GAIN) * pe.cost(current):

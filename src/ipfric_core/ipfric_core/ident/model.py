@@ -57,7 +57,8 @@ LAW_PARAMS = {'viscous': ('eps',), 'coulomb': ('Fc', 'Fs_excess', 'eps'),
 
 #: Effects the ladder adds, from the one library of :mod:`ipfric_core.ident.effects` (the base
 #: law's coulomb, stribeck and presliding are the declared friction here).
-LADDER_EFFECTS = ('deadzone', 'saturation', 'delay', 'cogging', 'asymmetry', 'offset', 'sensor_bias', 'backlash')
+LADDER_EFFECTS = ('deadzone', 'saturation', 'delay', 'cogging', 'asymmetry', 'offset', 'sensor_bias', 'backlash',
+                  'drive_backlash')
 
 
 @dataclass(frozen=True)
@@ -72,6 +73,7 @@ class ModelVectors:
     gap: float
     theta_bias: float
     delay: float
+    drive: tuple = (0.0, 0.0, 0.0, 0.0)   # play [m], motor-side mass [kg], contact k [N/m], c [N s/m]
 
 
 @dataclass(frozen=True)
@@ -144,6 +146,9 @@ class Model:
         return PlantTruth(cogging_N=amp, cogging_period_m=period, cogging_phase_rad=phase,
                           offset_N=self.get('F0'), deadzone_V=self.get('dz'), saturation_V=self.get('u_max'),
                           input_delay_s=round(self.get('delay') / dt) * dt, backlash_m=self.get('gap'),
+                          drive_backlash_m=self.get('drive_gap'), drive_mass_kg=self.get('drive_mass'),
+                          drive_stiffness_N_per_m=self.get('drive_stiffness'),
+                          drive_damping_Ns_per_m=self.get('drive_damping'),
                           bias_theta_rad=self.get('theta_bias'))
 
     def vectors(self) -> ModelVectors:
@@ -153,7 +158,9 @@ class Model:
         amp, period, phase = self.cogging()
         return ModelVectors(tuple(pp), friction_vector(self.friction_params(), self.normal_force),
                             (amp, period, phase, self.get('F0')), self.get('dz'), self.get('u_max'),
-                            self.get('gap'), self.get('theta_bias'), self.get('delay'))
+                            self.get('gap'), self.get('theta_bias'), self.get('delay'),
+                            (self.get('drive_gap'), self.get('drive_mass'), self.get('drive_stiffness'),
+                             self.get('drive_damping')))
 
 
 def declared(plant: PlantParams, friction: FrictionParams, pendulum: bool) -> Model:

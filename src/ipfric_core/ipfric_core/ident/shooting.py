@@ -9,7 +9,8 @@ unstable: a small error in its initial rate would grow into the cart's motion), 
 angle itself is judged on short windows of ``PENDULUM_WINDOW_S`` of the free coupled motion. The model (the
 plant of paper eq. (1)-(2), the friction law and the undeclared effects, all evaluated by
 :mod:`ipfric_core.physics`: :func:`~ipfric_core.physics.simulate.advance` with
-:func:`~ipfric_core.physics.rig.input_effects` and :func:`~ipfric_core.physics.rig.play`)
+:func:`~ipfric_core.physics.rig.input_effects`, :func:`~ipfric_core.physics.rig.play` and, for a drive
+with play, :func:`~ipfric_core.physics.simulate.advance_drive`)
 is integrated over the window with each command held until the next time stamp (the
 stamps may be uneven). The error is the simulated minus the measured encoder reading, in
 encoder counts; samples the record marks invalid (sample overruns) are not compared and
@@ -25,8 +26,9 @@ import numpy as np
 from scipy.signal import butter, sosfiltfilt
 
 from ..physics import compiled  # noqa: F401  (sets numba's cache directory)
-from ..physics.rig import input_effects, play
-from ..physics.simulate import advance
+from ..physics.plant import motor_force, motor_side_free
+from ..physics.rig import input_effects, inputs_through, play
+from ..physics.simulate import advance, advance_drive
 from .records import Record
 
 CART_WINDOW_S = 1.0
@@ -46,6 +48,7 @@ class Windows:
     state: np.ndarray     # (n, 5): x, theta, x', theta', z=0 at the start
     held: np.ndarray      # (n,): 1.0 where the cart stood still at the start
     forced: np.ndarray    # (n_samples, 2) measured angle and rate the simulation follows, or (0, 2)
+    motion: np.ndarray    # (n_samples, 2) measured cart speed [m/s] and acceleration [m/s^2] (:func:`rates`)
 
     def __len__(self) -> int:
         return len(self.start)
@@ -62,13 +65,18 @@ def rates(t: np.ndarray, y: np.ndarray, valid: np.ndarray) -> np.ndarray:
     return np.interp(t, grid, np.gradient(f, dt))
 
 
-def local_rate(t: np.ndarray, y: np.ndarray, k: int, half_s: float = 0.01) -> float:
-    """dy/dt at sample k [unit/s]: slope of a quadratic fitted over +/- ``half_s`` (at least two
-    samples each side), which follows a quantized signal through fast changes."""
+def local_rate(t: np.ndarray, y: np.ndarray, k: int, valid: np.ndarray, half_s: float = 0.01) -> float:
+    """dy/dt at sample k [unit/s]: slope of a quadratic fitted over the ``valid`` samples nearest
+    to k, as many each side as +/- ``half_s`` holds at the median period (at least two), which
+    follows a quantized signal through fast changes. A stale reading repeats an old position at
+    a new time: beside a sample overrun it would bend the fit by the motion it missed, so the fit
+    reaches past it to the fresh readings on that side."""
     dt = float(np.median(np.diff(t)))
     h = max(2, int(round(half_s / dt)))
-    lo, hi = max(0, k - h), min(len(t), k + h + 1)
-    c = np.polyfit(t[lo:hi] - t[k], y[lo:hi], 2)
+    idx = np.flatnonzero(valid)
+    at = int(np.searchsorted(idx, k))
+    use = idx[max(0, at - h):at + h + 1]
+    c = np.polyfit(t[use] - t[k], y[use], 2)
     return float(c[1])
 
 
@@ -116,12 +124,13 @@ def make_windows(rec: Record, length_s: float, forced: bool = False, span: float
             k = end - 1
     start, stop = np.array(starts, int), np.array(stops, int)
     held = rest[start].astype(float)
-    v = np.array([0.0 if h else local_rate(t, x, k) for k, h in zip(start, held)])
-    w = (np.array([local_rate(t, th, k) for k in start]) if rec.theta is not None
+    v = np.array([0.0 if h else local_rate(t, x, k, rec.valid_mask) for k, h in zip(start, held)])
+    w = (np.array([local_rate(t, th, k, rec.valid_mask) for k in start]) if rec.theta is not None
          else np.zeros(len(start)))
     state = np.column_stack([x[start], th[start], v, w, np.zeros(len(start))])
     angle = (np.column_stack([th, rates(t, th, rec.valid_mask)]) if forced else np.zeros((0, 2)))
-    return Windows(start, stop, state, held, angle)
+    speed = rates(t, x, rec.valid_mask)
+    return Windows(start, stop, state, held, angle, np.column_stack([speed, np.gradient(speed, t)]))
 
 
 def cart_windows(rec: Record) -> Windows:
@@ -137,23 +146,60 @@ def angle_windows(rec: Record) -> Windows:
     return make_windows(rec, PENDULUM_WINDOW_S, span=1.0)
 
 
+@numba.njit(cache=True)
+def drive_states(pp, gap, mass, t, u, motion):
+    """(d, vb, side) of a drive with play at every sample ((d, vb) is the state of
+    :func:`~ipfric_core.physics.simulate.advance_drive`; side +1 / -1 in contact pushing forward
+    / backward, 0 in the play), estimated by running its motor side along the measured cart: in
+    the play as :func:`~ipfric_core.physics.plant.motor_side_free` under the command ``u``
+    (after the input effects) while the cart moves as measured (``motion``: speed,
+    acceleration); at an edge of the play in contact (a stiff contact: its compression is
+    neglected), moving with the cart, until the contact force alpha u - beta x' - mass x''
+    turns against that edge."""
+    n = len(t)
+    out = np.empty((n, 3))
+    half = 0.5 * gap
+    d, vb, side = 0.0, motion[0, 0], 0.0
+    for k in range(n):
+        out[k, 0], out[k, 1], out[k, 2] = d, vb, side
+        if k == n - 1:
+            break
+        v0, v1 = motion[k, 0], motion[k + 1, 0]
+        if side != 0.0 and side * (motor_force(pp, u[k], v0) - mass * motion[k, 1]) >= 0.0:
+            vb = v1
+            continue
+        side = 0.0
+        h = t[k + 1] - t[k]
+        dx, vb = motor_side_free(pp, mass, vb, u[k], h)
+        d += dx - 0.5 * (v0 + v1) * h
+        if abs(d) >= half:
+            d, vb, side = math.copysign(half, d), v1, math.copysign(1.0, d)
+    return out
+
+
 @numba.njit(cache=True, parallel=True)   # the windows are independent: one thread each
-def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, t, u, start, stop, state, held,
+def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, drive0, t, u, start, stop, state, held,
            substep, forced, out):
     """Encoder readings (x, theta) predicted in every window, written into ``out`` (n, 2).
     Without a pendulum (pp's m = 0) the angle is held at 0; with ``forced`` (n, 2) rows, the
-    angle and its rate are set to them (less the bias) after every sample."""
+    angle and its rate are set to them (less the bias) after every sample. With a drive play
+    (``drive`` as :func:`~ipfric_core.physics.simulate.advance_drive` takes it, play > 0) each
+    window starts from the drive state ``drive0`` (n_windows, 2+) of :func:`drive_states`."""
     pendulum = pp[1] > 0.0
     force = len(forced) > 0
     for w in numba.prange(len(start)):
         s = (state[w, 0], state[w, 1] - theta_bias, state[w, 2], state[w, 3], state[w, 4])
         mode = (held[w], 0.0, 0.0)
+        dr = (drive0[w, 0], drive0[w, 1])
         reading = s[0]
         k0 = start[w]
         out[k0, 0], out[k0, 1] = reading, s[1] + theta_bias
         for k in range(k0, stop[w] - 1):
-            s, mode = advance(pp, fp, ef, s, mode, input_effects(u[k], deadzone, saturation),
-                              t[k + 1] - t[k], substep)
+            v = input_effects(u[k], deadzone, saturation)
+            if drive[0] > 0.0:
+                s, mode, dr = advance_drive(pp, fp, ef, s, mode, dr, v, t[k + 1] - t[k], substep, drive)
+            else:
+                s, mode = advance(pp, fp, ef, s, mode, v, t[k + 1] - t[k], substep)
             if force:
                 s = (s[0], forced[k + 1, 0] - theta_bias, s[2], forced[k + 1, 1], s[4])
             elif not pendulum:
@@ -191,10 +237,13 @@ class Prediction:
 
 def predict(model, rec: Record, win: Windows) -> Prediction:
     """Replay ``rec``'s command through ``model`` (an :class:`ident.model.ModelVectors`)."""
-    u = delayed(rec.t, rec.u, model.delay)
+    u = np.ascontiguousarray(delayed(rec.t, rec.u, model.delay), float)
     out = np.full((len(rec.t), 2), np.nan)
+    drive = tuple(float(v) for v in model.drive)
+    drive0 = (drive_states(model.pp, drive[0], drive[1], rec.t, inputs_through(u, model.deadzone, model.saturation),
+                           win.motion)[win.start] if drive[0] > 0.0 else np.zeros((len(win), 3)))
     _shoot(model.pp, model.fp, model.ef, model.deadzone, model.saturation, model.gap, model.theta_bias,
-           rec.t, np.ascontiguousarray(u, float), win.start, win.stop, win.state, win.held,
+           drive, drive0, rec.t, u, win.start, win.stop, win.state, win.held,
            min(1e-3, float(np.median(np.diff(rec.t)))), win.forced, out)
     window_of = np.full(len(rec.t), -1)
     for i, (a, b) in enumerate(zip(win.start, win.stop)):

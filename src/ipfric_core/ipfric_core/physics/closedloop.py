@@ -9,8 +9,8 @@ the same scalar functions (integrator, friction, plant, encoder, input effects,
 velocity filter, feedback), so both give the same trajectory. Its state between samples is
 one flat array (:func:`loop_start`), advanced by :func:`controller_sample`,
 :func:`drive_command` and :func:`plant_segment`, which is what shooting for periodic orbits
-varies; it needs fresh objects
-(nothing stepped yet) and covers every rig effect except sensor noise. ``auto`` takes
+varies; it needs fresh objects (nothing stepped yet) and covers every rig effect except
+sensor noise and a drive with play. ``auto`` takes
 the compiled engine whenever it can.
 """
 from __future__ import annotations
@@ -54,6 +54,8 @@ def compiled_unsupported(rig: Rig, controller: StateFeedback) -> str | None:
         return 'the controller has already been updated'
     if rig.effects.noise_x_m or rig.effects.noise_theta_rad:
         return 'sensor noise (plant_truth.noise_*) is drawn by the python engine only'
+    if rig.effects.drive_backlash_m:
+        return 'a drive with play (plant_truth.drive_backlash_m) is integrated by the python engine only'
     return None
 
 

@@ -112,6 +112,45 @@ NO_EXTRA_FORCE = (0.0, 1.0, 0.0, 0.0)
 
 
 @compiled
+def motor_side_free(pp, mass: float, vb: float, voltage: float, h: float):
+    """Motor side of a drive with play over ``h`` [s], ``voltage`` [V] held.
+
+    The motor's rotor and gears reflected to the rack as a mass ``mass`` [kg] driven by the
+    motor force of eq. (2) on its own speed: mass vb' = alpha V - beta vb (a contact force F
+    held over the step enters as V - F / alpha). Exact solution: it tends to alpha V / beta
+    [m/s] with time constant mass / beta [s] (at once for a massless motor side). Returns
+    (displacement [m], final speed vb [m/s]).
+    """
+    alpha, beta = pp[ALPHA], pp[BETA]
+    if beta <= 0.0:
+        if mass <= 0.0:
+            return vb * h, vb
+        a = alpha * voltage / mass
+        return vb * h + 0.5 * a * h * h, vb + a * h
+    v_inf = alpha * voltage / beta
+    if mass <= 0.0:
+        return v_inf * h, v_inf
+    tau = mass / beta
+    e = math.exp(-h / tau)
+    return v_inf * h + (vb - v_inf) * tau * (1.0 - e), v_inf + (vb - v_inf) * e
+
+
+@compiled
+def drive_contact_force(dp, d: float, dv: float) -> float:
+    """Force [N] on the cart from the motor side of a drive with play, ``dp`` = (play [m], motor-side
+    mass [kg], contact stiffness k [N/m], contact damping c [N s/m]), d = motor side minus cart [m],
+    dv its speed relative to the cart [m/s]: k (d -/+ play/2) + c dv beyond either edge of the play
+    (a stiff contact, the usual dead-zone model of a two-mass drive), 0 inside it. A contact only
+    pushes: the force never pulls the two together."""
+    half = 0.5 * dp[0]
+    if d > half:
+        return max(dp[2] * (d - half) + dp[3] * dv, 0.0)
+    if d < -half:
+        return min(dp[2] * (d + half) + dp[3] * dv, 0.0)
+    return 0.0
+
+
+@compiled
 def undeclared_forces(ef, x):
     """:func:`undeclared_force` along sampled positions ``x`` [m]."""
     out = np.empty(len(x))

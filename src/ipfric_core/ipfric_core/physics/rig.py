@@ -35,6 +35,12 @@ class PlantTruth:
     saturation_V : the drive cannot apply more than this [V] (0 = no limit)
     input_delay_s : transport delay of the command [s], a multiple of the sample period
     backlash_m : play between cart and its position encoder (rack and pinion) [m]
+    drive_backlash_m : play between the motor side of the drive and the cart [m]; the motor
+        side (rotor and gears reflected to the rack) crosses it without pushing the cart
+        (two-mass drive, ``simulate.advance_drive``); with it:
+    drive_mass_kg : that motor side's mass reflected to the rack [kg], > 0
+    drive_stiffness_N_per_m, drive_damping_Ns_per_m : its contact with the cart beyond the play,
+        k [N/m] > 0 and c [N s/m] (``plant.drive_contact_force``)
     bias_x_m, bias_theta_rad : constant sensor offsets [m], [rad]
     noise_x_m, noise_theta_rad : standard deviation of Gaussian sensor noise [m], [rad]
     noise_seed : seed of that noise
@@ -50,6 +56,10 @@ class PlantTruth:
     saturation_V: float = 0.0
     input_delay_s: float = 0.0
     backlash_m: float = 0.0
+    drive_backlash_m: float = 0.0
+    drive_mass_kg: float = 0.0
+    drive_stiffness_N_per_m: float = 0.0
+    drive_damping_Ns_per_m: float = 0.0
     bias_x_m: float = 0.0
     bias_theta_rad: float = 0.0
     noise_x_m: float = 0.0
@@ -63,6 +73,12 @@ class PlantTruth:
         """The forces fixed to the track as ``plant.undeclared_force`` takes them."""
         return (float(self.cogging_N), float(self.cogging_period_m), float(self.cogging_phase_rad),
                 float(self.offset_N))
+
+    def drive_vector(self) -> tuple:
+        """(play [m], motor-side mass [kg], contact stiffness [N/m], damping [N s/m]) of the drive, as
+        ``simulate.advance_drive`` takes them."""
+        return (float(self.drive_backlash_m), float(self.drive_mass_kg), float(self.drive_stiffness_N_per_m),
+                float(self.drive_damping_Ns_per_m))
 
     def true_friction(self, friction: FrictionParams) -> FrictionParams:
         """The declared friction law with the rig's direction dependence added."""
@@ -166,7 +182,7 @@ class Rig:
         friction = truth.true_friction(model.friction.params)
         if friction is not model.friction.params:
             model = CartPendulum(model.p, friction, model.friction.normal_force)
-        self.sim = Simulator(model, state0, extra_force=truth.force_vector())
+        self.sim = Simulator(model, state0, extra_force=truth.force_vector(), drive=truth.drive_vector())
         n = round(truth.input_delay_s / dt)
         self._pending = deque([0.0] * n)
         self._rng = random.Random(truth.noise_seed)

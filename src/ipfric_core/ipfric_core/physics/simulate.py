@@ -28,8 +28,10 @@ from .friction import friction_force, holding_margin, holds, sticks
 from .plant import (
     NO_EXTRA_FORCE,
     CartPendulum,
+    drive_contact_force,
     held_force,
     motor_force,
+    motor_side_free,
     rates,
     stuck_theta_acceleration,
     undeclared_force,
@@ -37,6 +39,8 @@ from .plant import (
 
 MAX_EVENTS = 64  # per substep; a guard, never reached in normal motion
 XTOL = 1e-13     # event time tolerance [s]
+CONTACT_STEPS = 40       # steps per period of the drive's contact oscillation
+NO_DRIVE = (0.0, 0.0, 0.0, 0.0)   # (play [m], motor-side mass [kg], stiffness [N/m], damping [N s/m]): rigid
 
 
 @compiled
@@ -198,6 +202,44 @@ def advance(pp, fp, ef, s, mode, voltage, dt, substep):
 
 
 @compiled
+def drive_step(dp, mass_cart: float, substep: float) -> float:
+    """Largest step [s] of :func:`advance_drive`: ``substep``, and CONTACT_STEPS per period of the
+    contact oscillation 2 pi sqrt(m_r / k) of the motor side (mass dp[1]) against the cart
+    (``mass_cart``), m_r their reduced mass."""
+    reduced = dp[1] * mass_cart / (dp[1] + mass_cart)
+    return min(substep, 2.0 * math.pi * math.sqrt(reduced / dp[2]) / CONTACT_STEPS)
+
+
+@compiled
+def advance_drive(pp, fp, ef, s, mode, drive, voltage, dt, substep, dp):
+    """:func:`advance` for a drive with play (backlash) between motor and cart.
+
+    Two-mass drive, ``dp`` = (play [m], motor-side mass [kg], contact stiffness [N/m], contact
+    damping [N s/m]): the motor side (rotor and gears reflected to the rack) takes the motor force
+    of eq. (2) (:func:`plant.motor_side_free`); the cart gets only the contact force
+    :func:`plant.drive_contact_force` (none inside the play) besides friction and its other
+    forces; the encoder reads the cart. ``drive`` = (d [m], vb [m/s]): motor side minus cart, and
+    the motor side's speed. Each step (:func:`drive_step`) holds the contact force at the mean of
+    its values at the start and at the end of a first pass (Heun), the cart advancing by
+    :func:`advance` (exact stick-slip) and the motor side exactly. Returns (state, mode, drive).
+    """
+    on_cart = (pp[0], pp[1], pp[2], pp[3], 1.0, 0.0)   # the "voltage" is then the force on the cart [N]
+    d, vb = drive
+    n = max(1, math.ceil(dt / drive_step(dp, pp[0], substep) - 1e-9))
+    h = dt / n
+    for _ in range(n):
+        f0 = drive_contact_force(dp, d, vb - s[2])
+        s1, _m = advance(on_cart, fp, ef, s, mode, f0, h, h)
+        dx, v1 = motor_side_free(pp, dp[1], vb, voltage - f0 / pp[4], h)
+        f = 0.5 * (f0 + drive_contact_force(dp, d + dx - (s1[0] - s[0]), v1 - s1[2]))
+        s1, mode = advance(on_cart, fp, ef, s, mode, f, h, h)
+        dx, vb = motor_side_free(pp, dp[1], vb, voltage - f / pp[4], h)
+        d += dx - (s1[0] - s[0])
+        s = s1
+    return s, mode, (d, vb)
+
+
+@compiled
 def friction_now(pp, fp, ef, s, mode, voltage):
     """Friction force on the cart in state ``s`` and ``mode`` [N] (static while stuck)."""
     if mode[0] != 0.0:
@@ -217,10 +259,13 @@ class Simulator:
         Largest RK4 step [s] (default 0.25 ms, four per 1 kHz sample).
     extra_force : (cogging [N], cogging period [m], asymmetry [N]), optional
         Forces on the cart the friction model does not know (:func:`plant.undeclared_force`).
+    drive : (play [m], motor-side mass [kg], contact stiffness [N/m], contact damping [N s/m]), optional
+        A drive with play between motor and cart (:func:`advance_drive`); play 0 = rigid. The
+        motor side starts at rest in the middle of the play.
     """
 
     def __init__(self, model: CartPendulum, state0, substep: float = 2.5e-4,
-                 extra_force: tuple = NO_EXTRA_FORCE):
+                 extra_force: tuple = NO_EXTRA_FORCE, drive: tuple = NO_DRIVE):
         self.model = model
         s = [float(v) for v in state0][:model.n_states]
         self._s = tuple(s + [0.0] * (5 - len(s)))
@@ -229,6 +274,8 @@ class Simulator:
         self.substep = float(substep)
         self.extra_force = tuple(float(v) for v in extra_force)
         self._pp, self._fp = model.vector, model.friction.vector
+        self.drive = tuple(float(v) for v in drive)
+        self._drive = (0.0, 0.0)  # motor side minus cart [m], its speed [m/s]
 
     @property
     def state(self) -> list:
@@ -260,11 +307,22 @@ class Simulator:
         return held(self._pp, self.extra_force, (float(s[0]), float(s[1]), 0.0, float(s[3]), 0.0), voltage)
 
     def friction_force(self, voltage: float) -> float:
-        """Friction force on the cart in the current state [N]."""
+        """Friction force on the cart in the current state [N]; with a drive with play, the force
+        of its contact (:func:`plant.drive_contact_force`) takes the motor force's place."""
+        if self.drive[0] > 0.0:
+            d, vb = self._drive
+            pp = self._pp
+            return friction_now((pp[0], pp[1], pp[2], pp[3], 1.0, 0.0), self._fp, self.extra_force, self._s,
+                                self._mode, drive_contact_force(self.drive, d, vb - self._s[2]))
         return friction_now(self._pp, self._fp, self.extra_force, self._s, self._mode, voltage)
 
     def step(self, voltage: float, dt: float) -> None:
         """Advance by ``dt`` [s] with the voltage held at ``voltage`` [V]."""
-        self._s, self._mode = advance(self._pp, self._fp, self.extra_force, self._s, self._mode,
-                                      float(voltage), float(dt), self.substep)
+        if self.drive[0] > 0.0:
+            self._s, self._mode, self._drive = advance_drive(
+                self._pp, self._fp, self.extra_force, self._s, self._mode, self._drive, float(voltage),
+                float(dt), self.substep, self.drive)
+        else:
+            self._s, self._mode = advance(self._pp, self._fp, self.extra_force, self._s, self._mode,
+                                          float(voltage), float(dt), self.substep)
         self.t += dt

@@ -92,6 +92,10 @@ PLANT_TRUTH_FIELDS = {
     'saturation_V': Field('V', 0.0, 1e3, 'drive saturation (0 = none)'),
     'input_delay_s': Field('s', 0.0, 10.0, 'transport delay of the command'),
     'backlash_m': Field('m', 0.0, 1.0, 'play between cart and its encoder'),
+    'drive_backlash_m': Field('m', 0.0, 1.0, 'play between the motor side of the drive and the cart'),
+    'drive_mass_kg': Field('kg', 0.0, 100.0, 'motor side of the drive reflected to the rack (with a play)'),
+    'drive_stiffness_N_per_m': Field('N/m', 0.0, 1e9, 'stiffness of the drive\'s contact beyond its play'),
+    'drive_damping_Ns_per_m': Field('N s/m', 0.0, 1e6, 'damping of the drive\'s contact beyond its play'),
     'bias_x_m': Field('m', -1.0, 1.0, 'cart sensor offset'),
     'bias_theta_rad': Field('rad', -1.0, 1.0, 'angle sensor offset'),
     'noise_x_m': Field('m', 0.0, 1.0, 'cart sensor noise (std)'),
@@ -171,6 +175,11 @@ def parse_sim(data: Mapping, path: str = 'sim_node.ros__parameters'):
         delay_samples(truth.input_delay_s, dt)
     except ValueError as exc:
         raise ConfigError(f'{path}.plant_truth.input_delay_s: {exc}') from exc
+    if truth.drive_backlash_m > 0.0:
+        for k in ('drive_mass_kg', 'drive_stiffness_N_per_m'):
+            if getattr(truth, k) <= 0.0:
+                raise ConfigError(f'{path}.plant_truth.{k}: must be > 0 with a drive_backlash_m '
+                                  f'({PLANT_TRUTH_FIELDS[k].unit}), got {getattr(truth, k)}')
     return sim, plant, friction, truth
 
 
