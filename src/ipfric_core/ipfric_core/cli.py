@@ -577,23 +577,14 @@ def cmd_bench(args) -> int:
     return 0
 
 
-ORBIT_PARAMETERS = ('delay', 'gain', 'friction')
-
-
 def _orbit_loop(base, name: str, value: float):
-    """The sampled loop of scenario ``base`` at continuation parameter ``name`` = ``value``."""
-    from dataclasses import replace
-
+    """The sampled loop of scenario ``base`` at continuation parameter ``name`` = ``value`` (a
+    delay may fall between samples here)."""
+    from .analysis.sweep import scenario_at
     from .design.orbit import loop_numbers
-    scn, delay = base, None
-    if name == 'delay':
-        delay = value
-    elif name == 'gain':
-        scn = replace(base, controller=replace(base.controller, gain=tuple(value * k for k in base.gain())))
-    else:
-        f = base.friction
-        scn = replace(base, friction=f.replace(mu_s=value * f.mu_s, mu_c=value * f.mu_c, eps=value * f.eps))
-    return loop_numbers(scn.make_rig().loop_spec(), scn.make_controller().loop_spec(), delay)
+    scn = base if name == 'delay' else scenario_at(base, name, value)
+    return loop_numbers(scn.make_rig().loop_spec(), scn.make_controller().loop_spec(),
+                        value if name == 'delay' else None)
 
 
 def cmd_orbit(args) -> int:
@@ -605,8 +596,9 @@ def cmd_orbit(args) -> int:
             cont = parse_continuation(args.continue_)
         except ValueError as exc:
             raise ConfigError(str(exc)) from None
-        if cont[0] not in ORBIT_PARAMETERS:
-            raise ConfigError(f'--continue {cont[0]!r}: unknown parameter; allowed: {", ".join(ORBIT_PARAMETERS)} '
+        from .analysis.sweep import PARAMETERS
+        if cont[0] not in PARAMETERS:
+            raise ConfigError(f'--continue {cont[0]!r}: unknown parameter; allowed: {", ".join(PARAMETERS)} '
                               '(delay [s]; gain and friction as multiples of the scenario\'s)')
         if cont[0] == 'delay' and min(cont[1]) < 0:
             raise ConfigError('--continue delay: delays must be >= 0 s')

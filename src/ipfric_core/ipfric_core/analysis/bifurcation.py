@@ -8,14 +8,13 @@ delay, the linear critical delay tau_c (eq. 27, tanh-smoothed friction) is marke
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from ..design.critical_delay import critical_delay, delayed_system
 from ..design.linearize import jacobian
-from .sweep import classify_run
+from .sweep import classify_run, scenario_at
 
 CLASS_COLOURS = {'settled': 'tab:green', 'limit_cycle': 'tab:blue', 'irregular': 'tab:orange',
                  'growing': 'tab:red', 'fallen': 'black'}
@@ -25,14 +24,7 @@ def simulated_classes(base, name: str, values, duration: float = 20.0) -> list[d
     """Class and cart amplitude of a run from the scenario's start at each parameter value."""
     rows = []
     for v in values:
-        if name == 'delay':
-            scn = replace(base, controller=replace(base.controller, delay=round(v / base.sample_period)
-                                                   * base.sample_period))
-        elif name == 'gain':
-            scn = replace(base, controller=replace(base.controller, gain=tuple(v * k for k in base.gain())))
-        else:
-            f = base.friction
-            scn = replace(base, friction=f.replace(mu_s=v * f.mu_s, mu_c=v * f.mu_c, eps=v * f.eps))
+        scn = scenario_at(base, name, v)
         o, _ = classify_run(scn, duration)
         rows.append({'parameter': v, 'class': o.cls, 'x_p2p_m': o.x_p2p})
     return rows

@@ -33,6 +33,25 @@ def cell_scenario(base: Scenario, tau: float, theta0_deg: float) -> Scenario:
                    controller=replace(base.controller, delay=float(tau)))
 
 
+#: what a continuation or a diagram varies: the delay [s], a multiple of the gain, a multiple of
+#: the friction coefficients (mu_s, mu_c, eps)
+PARAMETERS = ('delay', 'gain', 'friction')
+
+
+def scenario_at(base: Scenario, name: str, value: float) -> Scenario:
+    """``base`` with parameter ``name`` (one of :data:`PARAMETERS`) at ``value``; a delay is
+    rounded to whole samples (what the controller applies)."""
+    if name == 'delay':
+        return replace(base, controller=replace(base.controller,
+                                                delay=round(value / base.sample_period) * base.sample_period))
+    if name == 'gain':
+        return replace(base, controller=replace(base.controller, gain=tuple(value * k for k in base.gain())))
+    if name == 'friction':
+        f = base.friction
+        return replace(base, friction=f.replace(mu_s=value * f.mu_s, mu_c=value * f.mu_c, eps=value * f.eps))
+    raise ValueError(f'parameter {name!r}: expected one of {", ".join(PARAMETERS)}')
+
+
 def classify_samples(scn: Scenario, t, x, theta, fell: bool, window: float = 10.0):
     """:func:`classify` with the scenario's encoder counts and fallen angle."""
     return classify(t, x, theta, (scn.sim.cart_resolution, scn.sim.angle_resolution), scn.sim.fallen_angle,

@@ -37,11 +37,13 @@ from ..physics.closedloop import (
     LS_TIME,
     controller_sample,
     drive_command,
+    limit_code,
     loop_start,
     plant_segment,
     run_closed_loop,
 )
 from ..physics.compiled import compiled
+from ..physics.controller import FeedbackSpec
 from ..physics.friction import DYNAMIC, FP_MODEL
 
 #: what a cycle can end with
@@ -100,7 +102,6 @@ def loop_numbers(rig_spec, feedback_spec, delay: float | None = None) -> LoopNum
         if switch < 1e-12:
             switch = 0.0
         control = (control[0], control[1], float(whole), control[3])
-    from ..physics.controller import FeedbackSpec
     start = loop_start(r, FeedbackSpec(gain=tuple(f.gain), control=control))
     return LoopNumbers(tuple(r.plant), tuple(r.friction), tuple(r.extra_force), float(r.substep), float(r.dt),
                        tuple(r.resolution), tuple(r.sensors), tuple(r.drive), tuple(f.gain), control, switch,
@@ -116,17 +117,14 @@ def _cycle(pp, fp, ef, substep, dt, resolution, sensors, drive, gain, control, s
     ``out`` receives :data:`OUT`: samples N, extremes of the true x [m] and theta [rad] at the
     samples, samples stuck, sticking phases, code = index in :data:`CYCLE_CODES`.
     """
-    track_limit, fallen_angle = limits
     x_min = x_max = z[0]
     th_min = th_max = z[1]
     stuck, sticks, code = 0.0, 0.0, 1.0
     n = 0
     while n < max_samples:
-        if not (math.isfinite(z[0]) and math.isfinite(z[1])) or abs(z[1]) > fallen_angle:
-            code = 2.0
-            break
-        if abs(z[0]) > track_limit:
-            code = 3.0
+        limit = limit_code(z, limits)
+        if limit:
+            code = 1.0 + limit
             break
         x_min, x_max = min(x_min, z[0]), max(x_max, z[0])
         th_min, th_max = min(th_min, z[1]), max(th_max, z[1])

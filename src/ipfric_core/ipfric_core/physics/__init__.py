@@ -79,6 +79,7 @@ _WHERE = {
     'input_effects': 'rig',
     'inputs_through': 'rig',
     'load_yaml': 'params',
+    'limit_code': 'closedloop',
     'loop_start': 'closedloop',
     'loop_state_size': 'closedloop',
     'motor_force': 'plant',

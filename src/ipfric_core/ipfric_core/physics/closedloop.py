@@ -216,11 +216,20 @@ def plant_segment(pp, fp, ef, substep, z, start, end, switch):
 
 
 @compiled
+def limit_code(z, limits) -> int:
+    """0 inside the rig's limits, else the index in END_REASONS (1 fallen or not finite, 2 track)."""
+    if not (math.isfinite(z[0]) and math.isfinite(z[1])) or abs(z[1]) > limits[1]:
+        return 1
+    if abs(z[0]) > limits[0]:
+        return 2
+    return 0
+
+
+@compiled
 def _loop(pp, fp, ef, substep, dt, resolution, sensors, drive, gain, control, limits, z,
           t, st, meas, volt, fric, stuck):
     """The closed loop of :func:`_run_python`, compiled. Returns (samples, END_REASONS index)."""
     n = len(t)
-    track_limit, fallen_angle = limits
     for k in range(n):
         mx, mth, v = controller_sample(resolution, sensors, gain, control, z)
         t[k], meas[k, 0], meas[k, 1], volt[k] = z[LS_TIME], mx, mth, v
@@ -228,10 +237,9 @@ def _loop(pp, fp, ef, substep, dt, resolution, sensors, drive, gain, control, li
         st[k, 0], st[k, 1], st[k, 2], st[k, 3] = s[0], s[1], s[2], s[3]
         fric[k] = friction_now(pp, fp, ef, s, (z[5], z[6], z[7]), z[LS_APPLIED])
         stuck[k] = z[5] != 0.0
-        if not (math.isfinite(s[0]) and math.isfinite(s[1])) or abs(s[1]) > fallen_angle:
-            return k + 1, 1
-        if abs(s[0]) > track_limit:
-            return k + 1, 2
+        code = limit_code(z, limits)
+        if code:
+            return k + 1, code
         if k < n - 1:
             drive_command(drive, control, z, v)
             plant_segment(pp, fp, ef, substep, z, 0.0, dt, 0.0)
