@@ -70,27 +70,48 @@ def test_an_unstable_orbit_is_found_and_is_unstable():
     assert c.code != 'crossing' or abs(c.x_p2p - small.x_p2p) > 0.05 * small.x_p2p
 
 
-def test_branch_over_a_few_delays_follows_the_orbit():
+def test_branch_over_delays_follows_the_stick_slip_orbit():
     scn = exact('config/fig7_old_gain_exponential.yaml')
-    points, _ = trace(lambda tau: loop_of(scn, tau), [0.0, 0.001, 0.0015, 0.002], partners=False)
-    first = [p for p in points if p.branch == 0]
-    assert [p.parameter for p in first] == [0.0, 0.001, 0.0015, 0.002]   # 1.5 ms: between samples
-    for p in first[1:]:
-        sim_scn = replace(scn, controller=replace(scn.controller, delay=p.parameter)) \
-            if abs(p.parameter / 0.001 - round(p.parameter / 0.001)) < 1e-9 else None
-        if sim_scn is not None:
-            sim = simulated_cycle(sim_scn.make_rig(), sim_scn.make_controller(), 120.0)
-            assert p.orbit.x_p2p == pytest.approx(sim['x_p2p_m'], rel=1e-3)
-    # the sub-sample delay lies between its neighbours
-    x = [p.orbit.x_p2p for p in first]
-    assert min(x[1], x[3]) - 1e-6 <= x[2] <= max(x[1], x[3]) + 1e-6
+    found = trace(lambda tau: loop_of(scn, tau), 0.0, 0.012, points=8, probes=1, partners=False)
+    branch = [p for p in found.points if p.branch == 0]
+    taus = [p.parameter for p in branch]
+    assert taus[0] == 0.0 and taus[-1] == pytest.approx(0.012) and taus == sorted(taus)
+    assert any(abs(t / 0.001 - round(t / 0.001)) > 0.05 for t in taus)           # delays between samples
+    assert {e['event'] for e in found.events} == {'range'}
+    assert all(p.orbit.stable and p.orbit.sticks == 2 for p in branch)
+    # each point is the orbit itself: Newton from the loop's own cycle at that delay finds it again
+    mid = branch[len(branch) // 2]
+    again = find_orbit(loop_of(scn, mid.parameter))
+    assert mid.orbit.x_p2p == pytest.approx(again.x_p2p, rel=1e-4)
+    assert mid.orbit.period == pytest.approx(again.period, rel=1e-4)
+    # and the end point is the cycle of a long run at 12 ms
+    at = replace(scn, controller=replace(scn.controller, delay=0.012))
+    sim = simulated_cycle(at.make_rig(), at.make_controller(), 120.0)
+    assert branch[-1].orbit.x_p2p == pytest.approx(sim['x_p2p_m'], rel=1e-3)
+    assert branch[-1].orbit.period == pytest.approx(sim['period_s'], rel=1e-3)
+    # the period grows with the delay (5.41 s at 0, 5.53 s at 12 ms)
+    assert branch[-1].orbit.period - branch[0].orbit.period == pytest.approx(0.122, abs=0.01)
+
+
+def test_branch_of_the_large_cycle_grows_with_the_delay():
+    # from 45 ms the loop runs a large cycle without sticking (Figure 7's gain): 5.3 cm at 45 ms
+    scn = exact('config/fig7_old_gain_exponential.yaml')
+    found = trace(lambda tau: loop_of(scn, tau), 0.045, 0.06, points=5, probes=1, partners=False)
+    branch = [p for p in found.points if p.branch == 0]
+    x = [p.orbit.x_p2p for p in branch]
+    assert len(branch) >= 4 and all(b > a for a, b in zip(x, x[1:]))
+    assert all(p.orbit.stable and p.orbit.stuck_fraction == 0.0 for p in branch)
+    at = replace(scn, controller=replace(scn.controller, delay=0.06))
+    sim = simulated_cycle(at.make_rig(), at.make_controller(), 60.0)
+    assert branch[-1].orbit.x_p2p == pytest.approx(sim['x_p2p_m'], rel=1e-3)
 
 
 def test_parse_continuation():
-    assert parse_continuation('delay=0:0.1:3') == ('delay', [0.0, 0.05, 0.1])
-    assert parse_continuation('gain=1,1.2') == ('gain', [1.0, 1.2])
-    with pytest.raises(ValueError, match='START:STOP'):
-        parse_continuation('delay=0:0.1:1')
+    assert parse_continuation('delay=0:0.1:3') == ('delay', 0.0, 0.1, 3)
+    assert parse_continuation('gain=1:1.2') == ('gain', 1.0, 1.2, 100)
+    for bad in ('delay=0:0.1:1', 'delay=0:0.1:2.5', 'delay=0.1:0.1', 'delay=0:nan', 'delay'):
+        with pytest.raises(ValueError, match='START'):
+            parse_continuation(bad)
 
 
 def cli(*args):
@@ -105,7 +126,7 @@ def test_cli_refuses_an_unknown_parameter(tmp_path):
 
 
 def test_cli_writes_orbit_branch_and_diagram(tmp_path):
-    r = cli('--config', 'config/fig7_old_gain_exponential.yaml', '--continue', 'gain=1,1.05', '--simulate', '60',
+    r = cli('--config', 'config/fig7_old_gain_exponential.yaml', '--continue', 'gain=1:1.05:3', '--simulate', '60',
             '--out', str(tmp_path), '--json')
     assert r.returncode == 0, r.stderr
     res = json.loads(r.stdout)

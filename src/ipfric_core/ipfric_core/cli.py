@@ -600,7 +600,7 @@ def cmd_orbit(args) -> int:
         if cont[0] not in PARAMETERS:
             raise ConfigError(f'--continue {cont[0]!r}: unknown parameter; allowed: {", ".join(PARAMETERS)} '
                               '(delay [s]; gain and friction as multiples of the scenario\'s)')
-        if cont[0] == 'delay' and min(cont[1]) < 0:
+        if cont[0] == 'delay' and min(cont[1:3]) < 0:
             raise ConfigError('--continue delay: delays must be >= 0 s')
     import time
 
@@ -624,18 +624,22 @@ def cmd_orbit(args) -> int:
         from .design.orbit import simulated_cycle
         res['simulation'] = simulated_cycle(base.make_rig(), base.make_controller(), args.simulate)
     if cont:
-        name, values = cont
+        name, start, stop, count = cont
 
-        def progress(done, total):
-            print(f'\r[orbit] {name} {done}/{total}', end='' if done < total else '\n', file=sys.stderr, flush=True)
+        def progress(text):
+            print(f'[orbit] {name}: {text} ({time.perf_counter() - t0:.1f} s)', file=sys.stderr, flush=True)
 
         t0 = time.perf_counter()
-        points, events = trace(lambda v: _orbit_loop(base, name, v), values,
-                               progress=None if args.json else progress)
-        res['continuation'] = {'parameter': name, 'values': len(values), 'points': len(points), 'events': events,
+        found = trace(lambda v: _orbit_loop(base, name, v), start, stop, count,
+                      progress=None if args.json else progress)
+        events = found.events
+        res['continuation'] = {'parameter': name, 'range': [start, stop], 'points': len(found.points),
+                               'branches': len({p.branch for p in found.points}), 'events': events,
+                               'probes': found.probes, 'jacobians': found.jacobians, 'steps': found.steps,
                                'seconds': round(time.perf_counter() - t0, 2)}
+        values = [start + (stop - start) * i / 28 for i in range(29)]   # the simulations beside the branches
         import csv
-        rows = [p.row() for p in points]
+        rows = [p.row() for p in found.points]
         with open(out / 'branches.csv', 'w', newline='') as fh:
             wr = csv.DictWriter(fh, fieldnames=list(rows[0]) if rows else ['parameter'])
             wr.writeheader()
@@ -671,9 +675,11 @@ def cmd_orbit(args) -> int:
               f'period {s["period_s"]:.5f} s ({s["end_reason"]})')
     if cont:
         c = res['continuation']
-        print(f'  continuation in {c["parameter"]}: {c["points"]} orbits at {c["values"]} values, '
-              f'{c["seconds"]} s; events: ' + (', '.join(f'{e["event"]} of branch {e["branch"]} at '
-                                                        f'{e["parameter"]:.4g}' for e in c['events']) or 'none'))
+        print(f'  continuation in {c["parameter"]} over {c["range"][0]:g}:{c["range"][1]:g}: {c["points"]} orbits on '
+              f'{c["branches"]} branches, {c["jacobians"]} Jacobians, {c["seconds"]} s')
+        for e in c['events']:
+            print(f'    branch {e["branch"]}: {e["event"]} at {e["parameter"]:.5g}' +
+                  (f' ({e["multiplier"]})' if 'multiplier' in e else ''))
         if 'plot' in c:
             print(f'  diagram: {c["plot"]}')
     print(f'  written: {out / "orbit.json"}')
@@ -825,9 +831,10 @@ def build_parser() -> argparse.ArgumentParser:
     o.add_argument('--smoothing', choices=('none', 'tanh'), default=None, help='override the friction smoothing')
     o.add_argument('--cutoff-hz', type=float, default=None,
                    help='override the controller\'s velocity filter corner [Hz] (0 = raw difference)')
-    o.add_argument('--continue', dest='continue_', metavar='NAME=START:STOP[:COUNT]',
-                   help='trace the orbits over delay [s], gain or friction (multiples of the scenario\'s '
-                   'gain, or of its mu_s, mu_c and eps), e.g. delay=0:0.14:141')
+    o.add_argument('--continue', dest='continue_', metavar='NAME=START:STOP[:POINTS]',
+                   help='trace the branches of orbits over delay [s], gain or friction (multiples of the '
+                   'scenario\'s gain, or of its mu_s, mu_c and eps) by continuation, first step 1/(POINTS-1) '
+                   'of the range (default 100), e.g. delay=0:0.14')
     o.add_argument('--simulate', type=float, default=120.0,
                    help='also run the loop this many seconds and report its cycle beside the orbit (0 = no)')
     o.add_argument('--describing', action='store_true',

@@ -24,6 +24,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import numba
 import numpy as np
 
 from ..physics.closedloop import (
@@ -110,9 +111,9 @@ def loop_numbers(rig_spec, feedback_spec, delay: float | None = None) -> LoopNum
 
 @compiled
 def _cycle(pp, fp, ef, substep, dt, resolution, sensors, drive, gain, control, switch, limits,
-           z, level, max_samples, out):
+           z, level, min_samples, max_samples, out):
     """Run loop state ``z`` (at a sample, in place) to the next sample at which theta has risen
-    through ``level`` [rad] since the previous one.
+    through ``level`` [rad] since the previous one, ``min_samples`` on at the earliest.
 
     ``out`` receives :data:`OUT`: samples N, extremes of the true x [m] and theta [rad] at the
     samples, samples stuck, sticking phases, code = index in :data:`CYCLE_CODES`.
@@ -137,11 +138,29 @@ def _cycle(pp, fp, ef, substep, dt, resolution, sensors, drive, gain, control, s
             stuck += 1.0
             if not was_stuck:
                 sticks += 1.0
-        if before < level <= z[1]:
+        if before < level <= z[1] and n >= min_samples:
             code = 0.0
             break
     out[0], out[1], out[2], out[3], out[4] = n, x_min, x_max, th_min, th_max
     out[5], out[6], out[7] = stuck, sticks, code
+
+
+@compiled(parallel=True)
+def _cycles_apart(pp, fp, ef, substep, dt, resolution, sensors, drive, gain, control, switch, limits,
+                  z, moved, steps, level, crossings, min_samples, max_samples, ends, codes):
+    """``crossings`` passes of :func:`_cycle` from ``z`` with entry ``moved[j]`` moved by
+    ``steps[j]``, for every j (on every core): end states in ``ends[j]``, codes in ``codes[j]``."""
+    for j in numba.prange(len(moved)):
+        zj = z.copy()
+        zj[moved[j]] += steps[j]
+        out = np.zeros(len(OUT))
+        for _ in range(crossings):
+            _cycle(pp, fp, ef, substep, dt, resolution, sensors, drive, gain, control, switch, limits,
+                   zj, level, min_samples, max_samples, out)
+            if out[7] != 0.0:
+                break
+        ends[j, :] = zj
+        codes[j] = out[7]
 
 
 def free_entries(loop: LoopNumbers, n: int) -> np.ndarray:
@@ -183,9 +202,11 @@ class Cycle:
 
 
 def return_map(loop: LoopNumbers, z: np.ndarray, level: float, crossings: int = 1,
-               max_period: float = 60.0) -> Cycle:
+               max_period: float = 60.0, min_period: float = 0.0) -> Cycle:
     """P^crossings from loop state ``z`` (at a sample), the section being theta rising
-    through ``level`` [rad]; one pass ends after ``max_period`` [s] without a return."""
+    through ``level`` [rad]; one pass ends after ``max_period`` [s] without a return, and
+    returns no sooner than ``min_period`` [s] (a start just below the level does not count
+    the crossing right after it)."""
     z = np.array(z, dtype=float)
     out = np.zeros(len(OUT))
     n = stuck = sticks = 0
@@ -193,7 +214,7 @@ def return_map(loop: LoopNumbers, z: np.ndarray, level: float, crossings: int = 
     max_samples = int(max_period / loop.dt)
     code = 'crossing'
     for _ in range(crossings):
-        _cycle(*loop.args(), z, level, max_samples, out)
+        _cycle(*loop.args(), z, level, int(min_period / loop.dt), max_samples, out)
         code = CYCLE_CODES[int(out[7])]
         n += int(out[0])
         stuck += int(out[5])
@@ -209,7 +230,7 @@ def return_map(loop: LoopNumbers, z: np.ndarray, level: float, crossings: int = 
 def sample_step(loop: LoopNumbers, z: np.ndarray) -> np.ndarray:
     """The loop state one sample after ``z``."""
     z = np.array(z, dtype=float)
-    _cycle(*loop.args(), z, math.inf, 1, np.zeros(len(OUT)))
+    _cycle(*loop.args(), z, math.inf, 0, 1, np.zeros(len(OUT)))
     return z
 
 
@@ -254,8 +275,8 @@ class Orbit:
                 'residual': float(self.residual), 'newton_iterations': int(self.iterations)}
 
 
-def _residual(loop, z, level, crossings, idx, scale, w, s):
-    c = return_map(loop, z, level, crossings)
+def _residual(loop, z, level, crossings, idx, scale, w, s, min_period):
+    c = return_map(loop, z, level, crossings, min_period=min_period)
     if c.code != 'crossing':
         what = 'falls' if c.code == 'fallen' else c.code.replace('_', ' ')
         raise OrbitError(f'no return to the section: the loop {what}')
@@ -263,7 +284,7 @@ def _residual(loop, z, level, crossings, idx, scale, w, s):
 
 
 def shoot(loop: LoopNumbers, z: np.ndarray, level: float, crossings: int = 1, tol: float = 1e-9,
-          max_iter: int = 25) -> Orbit:
+          max_iter: int = 25, min_period: float = 0.0) -> Orbit:
     """Newton's method on P^m(u) - u + s w = 0, w . (u - u0) = 0 from loop state ``z`` (at a
     sample on the section of theta rising through ``level`` [rad])."""
     z = np.array(z, dtype=float)
@@ -273,11 +294,11 @@ def shoot(loop: LoopNumbers, z: np.ndarray, level: float, crossings: int = 1, to
     s = 0.0
     res = math.inf
     for it in range(1, max_iter + 1):
-        c, g = _residual(loop, z, level, crossings, idx, scale, w, s)
+        c, g = _residual(loop, z, level, crossings, idx, scale, w, s, min_period)
         res = float(np.max(np.abs(g)))
-        J = _jacobian(loop, z, level, crossings, idx, scale, c.state[idx])
+        J = return_map_jacobian(loop, z, level, crossings, idx, scale, c.state[idx], min_period=min_period)
         if res < tol:
-            return _orbit(loop, z, level, crossings, c, J, w, s, res, it)
+            return finish_orbit(loop, z, level, crossings, c, J, w, s, res, it)
         A = np.zeros((n + 1, n + 1))
         A[:n, :n] = J - np.eye(n)
         A[:n, n] = A[n, :n] = w / scale / max(np.linalg.norm(w / scale), 1e-300)
@@ -288,7 +309,7 @@ def shoot(loop: LoopNumbers, z: np.ndarray, level: float, crossings: int = 1, to
             zt = z.copy()
             zt[idx] += lam * du
             try:
-                _, gt = _residual(loop, zt, level, crossings, idx, scale, w, s + lam * ds)
+                _, gt = _residual(loop, zt, level, crossings, idx, scale, w, s + lam * ds, min_period)
             except OrbitError:
                 gt = np.array([math.inf])
             if np.max(np.abs(gt)) < res:
@@ -300,21 +321,20 @@ def shoot(loop: LoopNumbers, z: np.ndarray, level: float, crossings: int = 1, to
     raise OrbitError(f'Newton did not converge in {max_iter} iterations (residual {res:.3g})')
 
 
-def _jacobian(loop, z, level, crossings, idx, scale, base):
-    """Finite-difference D(P^m) on the free entries, in scaled units (forward differences)."""
-    J = np.empty((len(idx), len(idx)))
-    for j, i in enumerate(idx):
-        h = 1e-7 * max(abs(z[i]), scale[j])
-        zp = z.copy()
-        zp[i] += h
-        c = return_map(loop, zp, level, crossings)
-        if c.code != 'crossing':
-            raise OrbitError(f'the return map is not defined next to this state ({c.code.replace("_", " ")})')
-        J[:, j] = (c.state[idx] - base) / scale * (scale[j] / h)
-    return J
+def return_map_jacobian(loop, z, level, crossings, idx, scale, base, max_period: float = 60.0, min_period: float = 0.0):
+    """Finite-difference D(P^m) on the free entries, in scaled units (forward differences, the
+    columns on every core)."""
+    steps = 1e-7 * np.maximum(np.abs(z[idx]), scale)
+    ends, codes = np.empty((len(idx), len(z))), np.empty(len(idx))
+    _cycles_apart(*loop.args(), z, idx, steps, level, crossings, int(min_period / loop.dt),
+                  int(max_period / loop.dt), ends, codes)
+    if np.any(codes != 0.0):
+        bad = CYCLE_CODES[int(codes[np.flatnonzero(codes)[0]])]
+        raise OrbitError(f'the return map is not defined next to this state ({bad.replace("_", " ")})')
+    return (ends[:, idx] - base).T / scale[:, None] * (scale / steps)[None, :]
 
 
-def _orbit(loop, z, level, crossings, c, J, w, s, res, it) -> Orbit:
+def finish_orbit(loop, z, level, crossings, c, J, w, s, res, it) -> Orbit:
     vals, vecs = np.linalg.eig(J)
     wn = w / entry_scale(loop, len(z))
     wn = wn / max(np.linalg.norm(wn), 1e-300)

@@ -63,6 +63,9 @@ def use_cache(root: Path) -> Path:
 CACHE_DIR = use_cache(cache_root())
 
 
-def compiled(fn):
-    """``fn`` compiled to machine code on first use (or loaded from the cache)."""
+def compiled(fn=None, *, parallel: bool = False):
+    """``fn`` compiled to machine code on first use (or loaded from the cache); as
+    ``@compiled(parallel=True)`` its ``numba.prange`` loops run on every core."""
+    if fn is None:
+        return lambda f: numba.njit(cache=True, parallel=parallel)(f)
     return numba.njit(cache=True)(fn)
