@@ -23,7 +23,7 @@ import numpy as np
 
 from ipfric_core.analysis.montecarlo import parse_spread, run_chunk, run_montecarlo, spread_draw
 from ipfric_core.analysis.oscillation import classify, crossing_period
-from ipfric_core.analysis.sweep import cell_scenario, parse_range, sweep
+from ipfric_core.analysis.sweep import cell_scenario, parse_range, scenario_at, sweep
 from ipfric_core.design.paperconfig import REPO_ROOT
 from ipfric_core.executor import make_executor
 from ipfric_core.physics.closedloop import run_closed_loop
@@ -277,6 +277,34 @@ def bench_identify(quick: bool) -> list[dict]:
     return rows
 
 
+# ----------------------------------------------------------------------------------- orbits
+def bench_orbit(quick: bool) -> list[dict]:
+    """./ipfric orbit on Figure 7 (exact sensors): one orbit beside the 120 s run whose cycle it
+    predicts, and the branch over the delay 0-0.14 s (100 points) beside 100 runs of 20 s."""
+    from ipfric_core.cli import _orbit_loop
+    from ipfric_core.design.continuation import trace
+    from ipfric_core.design.orbit import find_orbit, simulated_cycle
+    base = exact(load_scenario(CONFIG / 'fig7_old_gain_exponential.yaml'))
+    find_orbit(_orbit_loop(base, 'delay', 0.0))                       # compile / load the cache
+    t_orbit, orbit = timed(lambda: find_orbit(_orbit_loop(base, 'delay', 0.0)), repeat=3)
+    long_run = 20.0 if quick else 120.0
+    t_sim, sim = timed(lambda: simulated_cycle(base.make_rig(), base.make_controller(), long_run))
+    err = max(abs(orbit.x_p2p / sim['x_p2p_m'] - 1), abs(orbit.period / sim['period_s'] - 1))
+    rows = [{'benchmark': 'one periodic orbit (Figure 7, exact sensors; shooting, Newton, multipliers)',
+             'reference': f'{long_run:g} s run {t_sim:.3g} s (orbit within {100 * err:.3g} % of its cycle)',
+             'ipfric': f'{t_orbit:.3g} s', 'ratio': t_sim / t_orbit, 'target': '< 1 s, within 0.1 % of the run',
+             'met': t_orbit < 1.0 and err < 1e-3}]
+    stop, points, runs = (0.01, 5, 5) if quick else (0.14, 100, 100)
+    t_branch, found = timed(lambda: trace(lambda v: _orbit_loop(base, 'delay', v), 0.0, stop, points, growth=1.0))
+    cells = [scenario_at(base, 'delay', stop * i / (runs - 1)) for i in range(runs)]
+    t_runs, _ = timed(lambda: [run_closed_loop(c.make_rig(), c.make_controller(), 20.0) for c in cells])
+    rows.append({'benchmark': f'orbit branches over the delay 0-{stop:g} s ({points} points, Figure 7)',
+                 'reference': f'{runs} runs of 20 s {t_runs:.3g} s',
+                 'ipfric': f'{t_branch:.3g} s ({len(found.points)} orbits, {found.jacobians} Jacobians)',
+                 'ratio': t_runs / t_branch, 'target': '< 30 s', 'met': t_branch < 30.0})
+    return rows
+
+
 # ------------------------------------------------------------------------------------ table
 COLUMNS = ('benchmark', 'reference', 'ipfric', 'ratio', 'target', 'met')
 
@@ -306,7 +334,7 @@ def run_all(quick: bool = False, realtime_s: float = 600.0, results: Path | None
     work = REPO_ROOT / 'runs' / ('bench-quick' if quick else 'bench') / 'work'  # the ROS runs, kept
     shutil.rmtree(work, ignore_errors=True)
     for name, fn in (('closed loop', lambda: bench_closed_loop(quick)), ('sweep', lambda: bench_sweep(quick)),
-                     ('Monte Carlo', lambda: bench_montecarlo(quick))):
+                     ('Monte Carlo', lambda: bench_montecarlo(quick)), ('orbits', lambda: bench_orbit(quick))):
         progress(f'[bench] {name} ...')
         rows += fn()
     progress('[bench] ROS lockstep, rclpy round trip, realtime ...')

@@ -146,10 +146,11 @@ class _Tracer:
     """Continuation of one parameter: ``make_loop(p)``, range [lo, hi], ``budget`` points per
     branch at most, first step ``ds0`` (in the norm above)."""
 
-    def __init__(self, make_loop, lo: float, hi: float, budget: int, ds0: float, tol: float = 1e-9):
+    def __init__(self, make_loop, lo: float, hi: float, budget: int, ds0: float, tol: float = 1e-9,
+                 growth: float = 4.0):
         self.make_loop, self.lo, self.hi, self.budget, self.tol = make_loop, lo, hi, budget, tol
         self.span = max(hi - lo, 1e-12)
-        self.ds0, self.ds_min, self.ds_max = ds0, ds0 / 64, 4 * ds0
+        self.ds0, self.ds_min, self.ds_max = ds0, ds0 / 64, growth * ds0
         self.result = Branches()
         self.floor = 0.0       # a pass returns no sooner than this [s]: half the last orbit's
 
@@ -364,6 +365,8 @@ class _Tracer:
                     p_pred, u_pred = jump.p, jump.u
         except OrbitError:
             pass
+        if _largest(a.orbit) >= 1.0:     # Newton alone only where the branch is stable
+            return None
         try:
             loop = self.loop_at(p_pred)
             orbit = shoot(loop, resized(u_pred, held, _layout(loop)[0]), level, crossings, self.tol, 10, self.floor)
@@ -417,7 +420,7 @@ def _crossing_kind(unstable: Orbit) -> str:
 
 
 def trace(make_loop: Callable[[float], LoopNumbers], start: float, stop: float, points: int = 100,
-          probes: int = 6, partners: bool = True, tol: float = 1e-7,
+          probes: int = 6, partners: bool = True, tol: float = 1e-7, growth: float = 4.0,
           progress: Callable[[str], None] | None = None) -> Branches:
     """Branches of orbits for the parameter in [start, stop].
 
@@ -426,10 +429,11 @@ def trace(make_loop: Callable[[float], LoopNumbers], start: float, stop: float, 
     ``points`` each way). Branches start from the orbit the loop runs into at ``start`` (and,
     with ``partners``, the unstable orbits found next to it), then from runs at ``probes``
     evenly spaced values whose cycles no traced branch holds. ``tol``: largest scaled residual
-    of a point (1e-7: 0.1 um in a cart position).
+    of a point (1e-7: 0.1 um in a cart position). Steps grow up to ``growth`` times the first
+    where the corrector converges fast (1: every step the first one).
     """
     lo, hi = min(start, stop), max(start, stop)
-    tr = _Tracer(make_loop, lo, hi, max(points, 2), 1.0 / (max(points, 2) - 1), tol)
+    tr = _Tracer(make_loop, lo, hi, max(points, 2), 1.0 / (max(points, 2) - 1), tol, growth)
     say = progress or (lambda text: None)
     grid = [lo + (hi - lo) * i / max(probes - 1, 1) for i in range(max(probes, 1))]
     for i, p in enumerate(grid):
