@@ -32,8 +32,86 @@ def _eig_text(pairs) -> str:
     return ', '.join(f'{re:.4f}' + (f'{im:+.4f}i' if im else '') for re, im in pairs)
 
 
+def _check_case(scn, label: str, value: float):
+    """The design check's view of scenario ``scn``: its physics and its loops (design.check.LOOPS)."""
+    from dataclasses import replace
+
+    from .design.check import CheckCase
+    viscous = replace(scn, friction=scn.friction.replace(model='viscous', smoothing='none'))
+    c = scn.controller
+    rigs = {'exact': _exact_sensors(scn), 'encoders': scn, 'viscous': _exact_sensors(viscous), 'floor': viscous}
+    return CheckCase(label, value, scn.plant, scn.friction, tuple(scn.gain()), c.delay, c.cutoff_hz,
+                     {k: v.make_rig().loop_spec() for k, v in rigs.items()}, scn.make_controller().loop_spec())
+
+
+def _design_check(args) -> int:
+    """``./ipfric design --check``: the page of a gain on a scenario (Markdown, PNG, JSON in --out)."""
+    config = args.config or str(REPO_ROOT / 'config' / 'default.yaml')
+    if args.from_ident and args.friction_change is not None:
+        raise ConfigError('--friction-change with --from-ident: the identification\'s standard errors set the '
+                          'friction cases; give one of them')
+    change = 0.3 if args.friction_change is None else args.friction_change
+    if not (math.isfinite(change) and 0.0 < change < 1.0):
+        raise ConfigError(f'--friction-change: {change!r} must be in (0, 1) (0.3 = friction x0.7 and x1.3)')
+    if not (math.isfinite(args.max_delay) and 0.0 < args.max_delay <= 1.0):
+        raise ConfigError(f'--max-delay: {args.max_delay!r} s must be in (0, 1] s')
+    from .run.scenario import load_scenario
+    try:
+        base = load_scenario(config)
+    except ConfigError as exc:
+        raise ConfigError(f'--config: {exc} (with --check: a scenario, e.g. config/default.yaml)') from None
+    if args.max_delay <= base.controller.delay:
+        raise ConfigError(f'--max-delay: {args.max_delay:g} s must exceed the scenario\'s delay '
+                          f'({base.controller.delay:g} s)')
+    if args.from_ident:
+        from .ident.uncertainty import friction_shift, load_report
+        model, std, dt = load_report(args.from_ident)
+        scenarios = [(f'friction {k:+d} SE' if k else 'identified', k, friction_shift(model, std, dt, base, k)[1])
+                     for k in (-1, 0, 1)]
+        axis = f'friction coefficients [standard errors of {args.from_ident}]'
+    else:
+        from .analysis.sweep import scenario_at
+        lo, hi = 1.0 - change, 1.0 + change
+        scenarios = [(f'friction x{lo:g}', lo, scenario_at(base, 'friction', lo)), ('scenario', 1.0, base),
+                     (f'friction x{hi:g}', hi, scenario_at(base, 'friction', hi))]
+        axis = 'friction scale (mu_s, mu_c, eps)'
+    cases = [_check_case(scn, label, value) for label, value, scn in scenarios]
+    import time
+
+    from .analysis.plots import check_figure
+    from .design.check import design_check
+    from .design.reports import check_page
+    t0 = time.perf_counter()
+
+    def progress(msg):
+        print(f'[design --check] {time.perf_counter() - t0:5.1f} s  {msg}', file=sys.stderr)
+    res = design_check(cases[1], [cases[0], cases[2]], args.max_delay, None if args.json else progress)
+    res.update(config=config, scenario=Path(config).stem, axis=axis, from_ident=args.from_ident,
+               encoders={'cart_m': base.sim.cart_resolution, 'angle_rad': base.sim.angle_resolution},
+               sample_period_s=base.sample_period, seconds=round(time.perf_counter() - t0, 1))
+    out = Path(args.out or 'runs/design-check')
+    out.mkdir(parents=True, exist_ok=True)
+    res['files'] = {'page': str(out / 'check.md'), 'figure': str(out / 'check.png'), 'json': str(out / 'check.json')}
+    check_figure(res, out / 'check.png')
+    (out / 'check.md').write_text(check_page(res, 'check.png'))
+    (out / 'check.json').write_text(json.dumps(res, indent=2, default=float))
+    if args.json:
+        _print_json(res)
+        return 0
+    print(res['verdict'])
+    print(f'page: {out / "check.md"}\nfigure: {out / "check.png"}\nnumbers: {out / "check.json"} '
+          f'({res["seconds"]} s)')
+    return 0
+
+
 def cmd_design(args) -> int:
-    cfg = load_paper_config(args.config)      # bad input refused before the long imports
+    if args.check:
+        return _design_check(args)
+    extra = [o for o, v in (('--out', args.out), ('--from-ident', args.from_ident),
+                            ('--friction-change', args.friction_change)) if v is not None]
+    if extra:
+        raise ConfigError(f'{", ".join(extra)}: only with --check')
+    cfg = load_paper_config(args.config or DEFAULT_CONFIG)      # bad input refused before the long imports
     from .design.reports import design_report
     tables = Path(args.data) / 'paper'
     if not tables.is_dir():
@@ -43,7 +121,7 @@ def cmd_design(args) -> int:
     if args.json:
         _print_json(rep)
         return 0
-    print(f'LQR gains, V = +K x, Q = diag{cfg.Q}, R = {cfg.R:g}  ({args.config})')
+    print(f'LQR gains, V = +K x, Q = diag{cfg.Q}, R = {cfg.R:g}  ({args.config or DEFAULT_CONFIG})')
     for name, e in rep['gains'].items():
         print(_row(f'{name} model, eq. {e["equation"]}', e))
         if 'full_gain_with_z' in e:
@@ -216,6 +294,12 @@ def cmd_analyze(args) -> int:
     return code
 
 
+def _exact_sensors(scn):
+    """Scenario ``scn`` with exact states for encoders (counts of 0)."""
+    from dataclasses import replace
+    return replace(scn, sim=replace(scn.sim, cart_resolution=0.0, angle_resolution=0.0))
+
+
 def _sweep_base(config, sensors, smoothing, cutoff_hz=None):
     from dataclasses import replace
 
@@ -226,7 +310,7 @@ def _sweep_base(config, sensors, smoothing, cutoff_hz=None):
             raise ConfigError(f'--cutoff-hz: {cutoff_hz!r} must be >= 0 Hz (0 = raw difference)')
         base = replace(base, controller=replace(base.controller, cutoff_hz=cutoff_hz))
     if sensors == 'exact':
-        base = replace(base, sim=replace(base.sim, cart_resolution=0.0, angle_resolution=0.0))
+        base = _exact_sensors(base)
     if smoothing:
         base = replace(base, friction=base.friction.replace(smoothing=smoothing))
     return base
@@ -699,8 +783,21 @@ def build_parser() -> argparse.ArgumentParser:
 
     d = add('design', cmd_design, 'LQR gains of the paper (15), (23), (25), eigenvalues and '
             'friction estimates, computed beside the printed values')
-    d.add_argument('--config', default=str(DEFAULT_CONFIG), help='paper parameter YAML (default %(default)s)')
+    d.add_argument('--config', default=None, help=f'paper parameter YAML (default {DEFAULT_CONFIG}); with --check '
+                   f'a scenario (default {REPO_ROOT / "config" / "default.yaml"})')
     d.add_argument('--data', default=str(DEFAULT_DATA), help='shared data directory (default %(default)s)')
+    d.add_argument('--check', action='store_true',
+                   help='check the scenario\'s gain instead: predicted hunting (orbit, encoders, describing '
+                   'function), linear and effective critical delay, encoder floor, each at friction x0.7 and x1.3; '
+                   'one page (check.md, check.png, check.json in --out)')
+    d.add_argument('--friction-change', type=float, default=None, metavar='F',
+                   help='--check: the friction cases, scale 1 -/+ F of mu_s, mu_c, eps (default 0.3)')
+    d.add_argument('--from-ident', metavar='DIR', default=None,
+                   help='--check: the friction cases from `./ipfric identify --out DIR`: the identified model and '
+                   'its friction coefficients all at -1 and +1 standard error (instead of --friction-change)')
+    d.add_argument('--max-delay', type=float, default=0.2,
+                   help='--check: the delay scan for the effective critical delay ends here [s] (default %(default)s)')
+    d.add_argument('--out', default=None, help='--check: directory of the page (default runs/design-check)')
     s = add('stability', cmd_stability, 'Routh-Hurwitz thresholds in delta and critical delays tau_c')
     s.add_argument('--config', default=str(DEFAULT_CONFIG), help='paper parameter YAML (default %(default)s)')
     m = add('demo', cmd_demo, 'the main job: a closed-loop run of the default scenario through the ROS 2 '

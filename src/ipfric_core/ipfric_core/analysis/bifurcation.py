@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..design.critical_delay import critical_delay, delayed_system
+from ..design.critical_delay import gain_critical_delay
 from ..design.linearize import jacobian
 from .sweep import classify_run, scenario_at
 
@@ -33,8 +33,7 @@ def simulated_classes(base, name: str, values, duration: float = 20.0) -> list[d
 def linear_critical_delay(base) -> float:
     """tau_c [s] of the scenario's gain on its plant, linearized with tanh-smoothed friction."""
     A, B = jacobian(base.plant, base.friction)
-    gain = list(base.gain()) + [0.0] * (A.shape[0] - 4)
-    return float(critical_delay(*delayed_system(A, B, gain))['tau_c'])
+    return float(gain_critical_delay(A, B, base.gain())['tau_c'])
 
 
 def diagram(base, name: str, values, rows: list[dict], events: list[dict], path: str | Path,

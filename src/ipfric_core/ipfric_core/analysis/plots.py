@@ -153,3 +153,49 @@ def montecarlo_figure(rows, hunting, title: str, path: str | Path) -> Path:
                        for c in CLASS_COLOURS if any(r['class'] == c for r in rows))
     fig.suptitle(f'{title}\n{len(rows)} runs: {shares}')
     return _save(fig, path)
+
+
+def check_figure(result: dict, path: str | Path) -> Path:
+    """The design check's figure (``design.check.design_check``): cart peak-to-peak and period of
+    the hunting against the friction cases (orbit with exact sensors, the encoders' cycle, the
+    describing function, the encoder floor), and the runs of the delay scan of the nominal case
+    with the linear and effective critical delays."""
+    cases = result['cases']
+    v = [c['value'] for c in cases]
+    fig, (a1, a2, a3) = plt.subplots(1, 3, figsize=(14, 4.2))
+
+    def line(ax, key, factor, style, label, colour):
+        y = [np.nan if c['numbers'][key] is None else factor * c['numbers'][key] for c in cases]
+        ax.plot(v, y, style, color=colour, label=label)
+    line(a1, 'x_p2p_exact_m', 100.0, 'o-', 'exact sensors (orbit; 0: rests)', 'tab:blue')
+    line(a1, 'x_p2p_encoders_m', 100.0, 's-', 'encoders', 'tab:orange')
+    line(a1, 'x_p2p_describing_m', 100.0, 'd:', 'describing function', 'tab:gray')
+    line(a1, 'floor_x_p2p_m', 100.0, 'v--', 'encoder floor (viscous only)', 'tab:green')
+    a1.set(xlabel=result['axis'], ylabel='cart peak-to-peak (cm)', title='hunting amplitude')
+    line(a2, 'period_exact_s', 1.0, 'o-', 'exact sensors (orbit)', 'tab:blue')
+    line(a2, 'period_encoders_s', 1.0, 's-', 'encoders', 'tab:orange')
+    line(a2, 'period_describing_s', 1.0, 'd:', 'describing function', 'tab:gray')
+    a2.set(xlabel=result['axis'], ylabel='period (s)', title='hunting period')
+    nominal = cases[result['nominal']]
+    for kind, colour in (('exact', 'tab:blue'), ('encoders', 'tab:orange')):
+        e = nominal['effective_delay'][kind]
+        held = [r for r in e['scan'] if r['holds']]
+        lost = [r for r in e['scan'] if not r['holds']]
+        a3.plot([1e3 * r['delay_s'] for r in held], [100 * max(r['x_p2p_m'], 1e-4) for r in held], 'o-', ms=3,
+                color=colour, label=f'runs, {"exact sensors" if kind == "exact" else "encoders"}')
+        if lost:
+            a3.plot([1e3 * r['delay_s'] for r in lost], [40.0] * len(lost), 'x', color=colour, ms=5)
+        if e['holds_to_s'] is not None:
+            a3.axvline(1e3 * e['holds_to_s'], color=colour, ls='--', lw=1,
+                       label=f'holds to {1e3 * e["holds_to_s"]:.1f} ms ({kind})')
+    tau = nominal['linear_critical_delay']['sliding']['tau_c']
+    if tau is not None:
+        a3.axvline(1e3 * tau, color='tab:red', ls='-.', lw=1, label=f'linear tau_c (sliding) {1e3 * tau:.1f} ms')
+    a3.set_yscale('log')
+    a3.set(xlabel='feedback delay (ms)', ylabel='cart peak-to-peak (cm); rest at 0.01, x: lost',
+           title=f'{nominal["label"]}: runs of {nominal["effective_delay"]["exact"]["run_s"]:g} s from the start')
+    for ax in (a1, a2, a3):
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.suptitle(f'design check: {result["scenario"]}, gain ' + ', '.join(f'{k:.4g}' for k in result['gain']))
+    return _save(fig, path)

@@ -53,3 +53,11 @@ def delayed_system(A, B, gain):
     """(A, E) of eq. (27): E = B K applies the delayed state (eqs. 29, 32)."""
     B = np.asarray(B, float).reshape(-1, 1)
     return np.asarray(A, float), B @ np.asarray(gain, float).reshape(1, -1)
+
+
+def gain_critical_delay(A, B, gain, **grid) -> dict:
+    """:func:`critical_delay` of the gain K [V per state unit] on (A, B) (``grid``: its
+    ``omega_max``, ``n_grid``); K is padded with zeros for the states it does not feed back
+    (the bristle state z of the dynamic law)."""
+    n = np.asarray(A).shape[0]
+    return critical_delay(*delayed_system(A, B, list(gain) + [0.0] * (n - len(gain))), **grid)

@@ -20,7 +20,7 @@ import numpy as np
 
 from ..physics.params import ConfigError, FrictionParams, PlantParams
 from ..run.scenario import Scenario
-from .model import PLANT_KNOWN, Model, declared
+from .model import FRICTION_FITTED, PLANT_KNOWN, Model, declared
 
 
 def load_report(path: str | Path) -> tuple[Model, dict[str, float], float]:
@@ -54,10 +54,27 @@ def report_draw(model: Model, std: dict[str, float], dt: float, base: Scenario, 
     drawn model's plant, friction and plant_truth; the controller stays ``base``'s)."""
     rng = np.random.default_rng([seed, index])
     names = sorted(std)
-    z = rng.standard_normal(len(names))
+    return report_scenario(model, std, dt, base, dict(zip(names, rng.standard_normal(len(names)))))
+
+
+def report_scenario(model: Model, std: dict[str, float], dt: float, base: Scenario,
+                    z: dict[str, float]) -> tuple[dict, Scenario]:
+    """Each parameter of ``z`` at value + z std, clipped to its bounds; (those values, ``base``
+    with the model's plant, friction and plant_truth at them; the controller stays ``base``'s)."""
     values = {}
-    for name, zi in zip(names, z):
+    for name, zi in z.items():
         p = model.param(name)
         values[name] = min(max(p.value + std[name] * zi, p.lo), p.hi)
     m = model.with_values(values)
     return values, replace(base, plant=m.plant_params(), friction=m.friction_params(), truth=m.plant_truth(dt))
+
+
+def friction_shift(model: Model, std: dict[str, float], dt: float, base: Scenario, k: float) -> tuple[dict, Scenario]:
+    """The friction law's fitted parameters (levels, viscous coefficient, Stribeck velocity) that
+    have a standard error all at value + k std, the rest at their values (:func:`report_scenario`):
+    k = +1 is the friction one standard error up on every coefficient at once."""
+    names = sorted(n for n in std if n in FRICTION_FITTED)
+    if not names:
+        raise ConfigError('--from-ident: the report gives no standard error for the friction law\'s '
+                          f'parameters ({", ".join(FRICTION_FITTED)})')
+    return report_scenario(model, std, dt, base, dict.fromkeys(names, float(k)))
