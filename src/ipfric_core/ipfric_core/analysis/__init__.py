@@ -48,7 +48,6 @@ _WHERE = {
     'crossing_period': 'oscillation',
     'diagram': 'bifurcation',
     'grid': 'sweep',
-    'linear_critical_delay': 'bifurcation',
     'load_cells': 'sweep',
     'loop_timing': 'recorded_run',
     'mcap_file': 'bagread',

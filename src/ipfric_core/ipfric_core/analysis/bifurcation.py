@@ -3,7 +3,7 @@ overlaid on what simulations from the scenario's start do at the same parameters
 
 Stable orbits are drawn solid, unstable dashed; each simulation is a marker coloured by its
 class (:func:`ipfric_core.analysis.oscillation.classify`) at its cart amplitude; for the
-delay, the linear critical delay tau_c (eq. 27, tanh-smoothed friction) is marked.
+delay, the linear critical delays tau_c (eq. 27, tanh-smoothed friction and sliding cart) are marked.
 """
 from __future__ import annotations
 
@@ -12,8 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..design.critical_delay import gain_critical_delay
-from ..design.linearize import jacobian
+from ..design.check import linear_delays
 from .sweep import classify_run, scenario_at
 
 CLASS_COLOURS = {'settled': 'tab:green', 'limit_cycle': 'tab:blue', 'irregular': 'tab:orange',
@@ -28,12 +27,6 @@ def simulated_classes(base, name: str, values, duration: float = 20.0) -> list[d
         o, _ = classify_run(scn, duration)
         rows.append({'parameter': v, 'class': o.cls, 'x_p2p_m': o.x_p2p})
     return rows
-
-
-def linear_critical_delay(base) -> float:
-    """tau_c [s] of the scenario's gain on its plant, linearized with tanh-smoothed friction."""
-    A, B = jacobian(base.plant, base.friction)
-    return float(gain_critical_delay(A, B, base.gain())['tau_c'])
 
 
 def diagram(base, name: str, values, rows: list[dict], events: list[dict], path: str | Path,
@@ -65,9 +58,11 @@ def diagram(base, name: str, values, rows: list[dict], events: list[dict], path:
         if e['event'] == 'fold':
             ax.axvline(e['parameter'], color='tab:purple', lw=0.6, ls=':')
     if name == 'delay':
-        tau_c = linear_critical_delay(base)
-        if math.isfinite(tau_c) and min(values) <= tau_c <= max(values):
-            ax.axvline(tau_c, color='tab:red', lw=1, ls='-.', label=f'linear tau_c = {tau_c:.4f} s')
+        tau = linear_delays(base.plant, base.friction, base.gain())
+        for kind, style, what in (('tanh', '-.', 'tanh-smoothed friction'), ('sliding', '--', 'sliding cart')):
+            tau_c = tau[kind]['tau_c']
+            if math.isfinite(tau_c) and 0 < tau_c and min(values) <= tau_c <= max(values):
+                ax.axvline(tau_c, color='tab:red', lw=1, ls=style, label=f'linear tau_c, {what}: {1e3 * tau_c:.1f} ms')
     ax.set_xlabel({'delay': 'feedback delay tau [s]', 'gain': 'gain scale', 'friction': 'friction scale'}[name])
     ax.set_ylabel('cart peak-to-peak [cm]')
     ax.set_yscale('log')
