@@ -335,7 +335,7 @@ class _Tracer:
             if last or not (self.lo + 1e-9 * self.span < p < self.hi - 1e-9 * self.span):
                 end = 'range'
                 break
-            if arc and abs(tq) > 0.5 and not _near_one(orbit):
+            if arc and not _near_one(orbit):
                 arc = False                    # past the fold: steps in p again
             grow = 1.5 if orbit.iterations <= 4 else 1.0
             ds, dp = min(self.ds_max, ds * grow), min(self.ds_max * self.span, dp * grow)
@@ -402,7 +402,7 @@ class _Tracer:
                    for bp in self.result.points)
 
 
-def _near_one(o: Orbit, within: float = 0.3) -> bool:
+def _near_one(o: Orbit, within: float = 0.15) -> bool:
     """Whether a real multiplier of ``o`` lies within ``within`` of +1 (as at a fold)."""
     m = o.multipliers
     return bool(np.any((np.abs(np.imag(m)) < 1e-9) & (np.abs(np.real(m) - 1.0) < within)))
