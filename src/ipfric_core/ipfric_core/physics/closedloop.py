@@ -151,7 +151,7 @@ def loop_start(r, f) -> np.ndarray:
     return z
 
 
-@compiled(inline=True)
+@compiled
 def controller_sample(resolution, sensors, gain, control, z):
     """Encoders read the rig, the controller estimates and commands: (x [m], theta [rad], V [V]).
 
@@ -178,7 +178,7 @@ def controller_sample(resolution, sensors, gain, control, z):
     return mx, mth, v
 
 
-@compiled(inline=True)
+@compiled
 def drive_command(drive, control, z, v):
     """The command ``v`` [V] enters the drive; the voltage reaching the motor (after the input
     delay, deadzone and saturation) is held in ``z`` for the next interval [V]."""
@@ -194,7 +194,7 @@ def drive_command(drive, control, z, v):
     z[o + input_delay - 1] = v
 
 
-@compiled(inline=True)
+@compiled
 def plant_segment(pp, fp, ef, substep, z, start, end, switch):
     """Advance the plant in ``z`` from ``start`` to ``end`` [s] after a sample.
 
@@ -215,7 +215,7 @@ def plant_segment(pp, fp, ef, substep, z, start, end, switch):
             start = stop
 
 
-@compiled(inline=True)
+@compiled
 def limit_code(z, limits) -> int:
     """0 inside the rig's limits, else the index in END_REASONS (1 fallen or not finite, 2 track)."""
     if not (math.isfinite(z[0]) and math.isfinite(z[1])) or abs(z[1]) > limits[1]:

@@ -63,15 +63,9 @@ def use_cache(root: Path) -> Path:
 CACHE_DIR = use_cache(cache_root())
 
 
-def compiled(fn=None, *, inline: bool = False, parallel: bool = False):
-    """``fn`` compiled to machine code on first use (or loaded from the cache).
-
-    ``@compiled(inline=True)``: numba writes the body into every compiled caller instead of a
-    call (for what runs each substep or sample: no call overhead and no reference counting
-    of the arrays passed); called from Python, it is compiled on its own as usual. Inlining
-    leaves the arithmetic as written (no fast-math), so results are the same to the bit.
-    ``@compiled(parallel=True)``: its ``numba.prange`` loops run on every core.
-    """
+def compiled(fn=None, *, parallel: bool = False):
+    """``fn`` compiled to machine code on first use (or loaded from the cache); as
+    ``@compiled(parallel=True)`` its ``numba.prange`` loops run on every core."""
     if fn is None:
-        return lambda f: compiled(f, inline=inline, parallel=parallel)
-    return numba.njit(cache=True, inline='always' if inline else 'never', parallel=parallel)(fn)
+        return lambda f: numba.njit(cache=True, parallel=parallel)(f)
+    return numba.njit(cache=True)(fn)

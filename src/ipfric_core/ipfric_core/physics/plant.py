@@ -159,7 +159,7 @@ def undeclared_forces(ef, x):
     return out
 
 
-@compiled(inline=True)
+@compiled
 def rates(pp, fp, ef, s, voltage: float, direction: float):
     """ds/dt of the sliding (or smooth) motion, eq. (16) with (17) and the friction law.
 

@@ -43,7 +43,7 @@ CONTACT_STEPS = 40       # steps per period of the drive's contact oscillation
 NO_DRIVE = (0.0, 0.0, 0.0, 0.0)   # (play [m], motor-side mass [kg], stiffness [N/m], damping [N s/m]): rigid
 
 
-@compiled(inline=True)
+@compiled
 def rk4_slide(pp, fp, ef, s, h, voltage, d):
     """One RK4 step of length ``h`` [s] of the sliding motion with sgn(x') = ``d``."""
     k1 = rates(pp, fp, ef, s, voltage, d)
@@ -148,7 +148,7 @@ def _settle(pp, fp, ef, s, voltage, events):
     return s, (0.0, math.copysign(1.0, applied), events + 1.0)
 
 
-@compiled(inline=True)
+@compiled
 def _advance_hybrid(pp, fp, ef, s, mode, h, voltage):
     stuck, d, events = mode
     remaining = h
