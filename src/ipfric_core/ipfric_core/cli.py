@@ -749,7 +749,7 @@ def cmd_orbit(args) -> int:
     if not orbits:
         print(f'  none: {why}')
     for o in orbits:
-        m = abs(o.multipliers[0]) if len(o.multipliers) else 0.0
+        m = o.largest_multiplier
         print(f'  {"stable  " if o.stable else "unstable"} x p2p {100 * o.x_p2p:.4f} cm, theta p2p '
               f'{o.theta_p2p:.3e} rad, period {o.period:.5f} s, stuck {100 * o.stuck_fraction:.1f} % '
               f'({o.sticks} sticking phases), largest multiplier |{m:.3g}|')
@@ -768,6 +768,17 @@ def cmd_orbit(args) -> int:
             print(f'  diagram: {c["plot"]}')
     print(f'  written: {out / "orbit.json"}')
     return 0
+
+
+def loop_variant_options(parser) -> None:
+    """--sensors, --smoothing and --cutoff-hz: the loop a scenario is run as (see _sweep_base)."""
+    parser.add_argument('--sensors', choices=('exact', 'config'), default='exact',
+                        help='exact states as in the paper\'s simulations, or the scenario\'s encoders '
+                        '(default %(default)s)')
+    parser.add_argument('--smoothing', choices=('none', 'tanh'), default=None,
+                        help='override the friction smoothing')
+    parser.add_argument('--cutoff-hz', type=float, default=None,
+                        help='override the controller\'s velocity filter corner [Hz] (0 = raw difference)')
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -835,10 +846,7 @@ def build_parser() -> argparse.ArgumentParser:
     w.add_argument('--tau', default='0:0.14:0.005', help='delays [s], start:stop:step or a,b,c (default %(default)s)')
     w.add_argument('--theta0-deg', default='0:12:0.5', help='initial angles [deg] (default %(default)s)')
     w.add_argument('--duration', type=float, default=20.0, help='simulated seconds per cell (default %(default)s)')
-    w.add_argument('--sensors', choices=('exact', 'config'), default='exact',
-                   help='exact states as in the paper\'s simulations, or the scenario\'s encoders '
-                   '(default %(default)s)')
-    w.add_argument('--smoothing', choices=('none', 'tanh'), default=None, help='override the friction smoothing')
+    loop_variant_options(w)
     w.add_argument('--workers', type=int, default=None,
                    help='parallel cells in local processes (default: all cores offline, 1 with --ros)')
     w.add_argument('--scheduler', default=None, metavar='ADDRESS',
@@ -859,8 +867,6 @@ def build_parser() -> argparse.ArgumentParser:
     w.add_argument('--threshold', default=None, metavar='LO,HI',
                    help='instead of a map: bisect the initial angle [rad] between a settling LO and a '
                         'cycling HI (bistability, Figure 8b)')
-    w.add_argument('--cutoff-hz', type=float, default=None,
-                   help='override the controller\'s velocity filter corner [Hz] (0 = raw difference)')
     w.add_argument('--out', required=True, help='directory for cells.csv, map.png, summary.json')
     mc = add('montecarlo', cmd_montecarlo, 'distribution of the hunting (cart and angle peak-to-peak, period, '
              'class) over N runs of a scenario with its parameters drawn at random: relative spreads, or an '
@@ -922,12 +928,7 @@ def build_parser() -> argparse.ArgumentParser:
             'the delay, a gain scale or a friction scale (bifurcation diagram)')
     o.add_argument('--config', default=str(REPO_ROOT / 'config' / 'default.yaml'),
                    help='scenario (default %(default)s)')
-    o.add_argument('--sensors', choices=('exact', 'config'), default='exact',
-                   help='exact states as in the paper\'s simulations, or the scenario\'s encoders '
-                   '(default %(default)s)')
-    o.add_argument('--smoothing', choices=('none', 'tanh'), default=None, help='override the friction smoothing')
-    o.add_argument('--cutoff-hz', type=float, default=None,
-                   help='override the controller\'s velocity filter corner [Hz] (0 = raw difference)')
+    loop_variant_options(o)
     o.add_argument('--continue', dest='continue_', metavar='NAME=START:STOP[:POINTS]',
                    help='trace the branches of orbits over delay [s], gain or friction (multiples of the '
                    'scenario\'s gain, or of its mu_s, mu_c and eps) by continuation, first step 1/(POINTS-1) '

@@ -101,7 +101,7 @@ _WHERE = {
     'return_map': 'orbit',
     'rhp_root_count': 'stability',
     'routh_first_column': 'stability',
-    'sample_step': 'orbit',
+    'motion': 'orbit',
     'sensitivity': 'check',
     'settle': 'orbit',
     'settled_cycle': 'check',

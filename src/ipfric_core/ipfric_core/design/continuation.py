@@ -39,10 +39,10 @@ from .orbit import (
     find_orbit,
     finish_orbit,
     free_entries,
+    motion,
     resized,
     return_map,
     return_map_jacobian,
-    sample_step,
     settle,
     shoot,
     shrunk,
@@ -72,7 +72,7 @@ class BranchPoint:
         o = self.orbit
         return {'parameter': self.parameter, 'branch': self.branch, 'x_p2p_m': o.x_p2p, 'theta_p2p_rad': o.theta_p2p,
                 'period_s': o.period, 'stable': o.stable,
-                'max_multiplier_modulus': float(abs(o.multipliers[0])) if len(o.multipliers) else 0.0,
+                'max_multiplier_modulus': o.largest_multiplier,
                 'stuck_fraction': o.stuck_fraction, 'residual': o.residual}
 
 
@@ -194,7 +194,7 @@ class _Tracer:
         layout = _layout(loop)
         idx, scale = _scaled(loop, len(u_pred))
         n = len(idx)
-        w = (sample_step(loop, u_pred)[idx] - u_pred[idx]) / loop.dt / scale
+        w = motion(loop, u_pred, idx) / scale
         wn = w / max(np.linalg.norm(w), 1e-300)
         tv = tu[idx] / scale
         v_pred, q_pred = u_pred[idx] / scale, (p_pred - self.lo) / self.span
@@ -218,7 +218,7 @@ class _Tracer:
                 if J is None:
                     J, _ = self.derivatives(here, p, u, level, crossings, idx, scale, column=False)
                 orbit = finish_orbit(here, u, level, crossings, c, J, w * scale, s, res, it)
-                if NEAR_CRITICAL[0] < _largest(orbit) < NEAR_CRITICAL[1] and it > 1:   # J at the solution
+                if NEAR_CRITICAL[0] < orbit.largest_multiplier < NEAR_CRITICAL[1] and it > 1:   # J at the solution
                     J, _ = self.derivatives(here, p, u, level, crossings, idx, scale, column=False)
                     orbit = finish_orbit(here, u, level, crossings, c, J, w * scale, s, res, it)
                 return p, here, orbit
@@ -227,10 +227,7 @@ class _Tracer:
                     raise OrbitError(f'the corrector stalled at residual {res:.3g}')
                 J, col = self.derivatives(here, p, u, level, crossings, idx, scale, column=not fixed)
                 taken += 1
-                A = np.zeros((n + 2, n + 2))
-                A[:n, :n] = J - np.eye(n)
-                A[:n, n], A[:n, n + 1] = w, col
-                A[n, :n] = wn
+                A = np.vstack([_bordered(J, w, col), np.zeros(n + 2)])
                 if fixed:
                     A[n + 1, n + 1] = 1.0
                 else:
@@ -249,13 +246,9 @@ class _Tracer:
         u = orbit.state
         idx, scale = _scaled(loop, len(u))
         J, col = self.derivatives(loop, p, u, orbit.level, orbit.crossings, idx, scale)
-        w = (sample_step(loop, u)[idx] - u[idx]) / loop.dt / scale
+        w = motion(loop, u, idx) / scale
         n = len(idx)
-        A = np.zeros((n + 1, n + 2))
-        A[:n, :n] = J - np.eye(n)
-        A[:n, n], A[:n, n + 1] = w, col
-        A[n, :n] = w / max(np.linalg.norm(w), 1e-300)
-        null = np.linalg.svd(A)[2][-1]
+        null = np.linalg.svd(_bordered(J, w, col))[2][-1]
         tu = np.zeros(len(orbit.state))
         tu[idx] = null[:n] * scale
         tq = float(null[n + 1])
@@ -269,7 +262,7 @@ class _Tracer:
         idx, scale = _scaled(loop, len(u))
         prev = resized(a.orbit.state, _layout(a.loop)[0], _layout(loop)[0])
         dv = (u[idx] - prev[idx]) / scale
-        w = (sample_step(loop, u)[idx] - u[idx]) / scale
+        w = motion(loop, u, idx) / scale
         w /= max(np.linalg.norm(w), 1e-300)
         dv -= (dv @ w) * w
         dq = (p - a.p) / self.span
@@ -340,7 +333,7 @@ class _Tracer:
             grow = 1.5 if orbit.iterations <= 4 else 1.0
             ds, dp = min(self.ds_max, ds * grow), min(self.ds_max * self.span, dp * grow)
         events.append({'parameter': a.p, 'branch': branch, 'event': end, 'x_p2p_m': a.orbit.x_p2p,
-                       'max_multiplier_modulus': _largest(a.orbit)})
+                       'max_multiplier_modulus': a.orbit.largest_multiplier})
         return out
 
     def solve(self, a: _Point, p_pred: float, u_pred: np.ndarray, level: float, crossings: int,
@@ -353,7 +346,7 @@ class _Tracer:
                 loop_pred = self.loop_at(p_pred)
                 new = _layout(loop_pred)[0]
                 u_pred, tu, held = resized(u_pred, held, new), resized(tu, held, new), new
-                if fixed and _largest(a.orbit) < CONTRACTING:   # the loop itself brings the state in
+                if fixed and a.orbit.largest_multiplier < CONTRACTING:   # the loop itself brings the state in
                     for _ in range(2):
                         c = return_map(loop_pred, u_pred, level, crossings, min_period=self.floor)
                         if c.code != 'crossing':
@@ -365,7 +358,7 @@ class _Tracer:
                     p_pred, u_pred = jump.p, jump.u
         except OrbitError:
             pass
-        if _largest(a.orbit) >= 1.0:     # Newton alone only where the branch is stable
+        if a.orbit.largest_multiplier >= 1.0:     # Newton alone only where the branch is stable
             return None
         try:
             loop = self.loop_at(p_pred)
@@ -402,14 +395,21 @@ class _Tracer:
                    for bp in self.result.points)
 
 
+def _bordered(J: np.ndarray, w: np.ndarray, col: np.ndarray) -> np.ndarray:
+    """[[J - I, w, dP/dq], [w / |w|, 0, 0]]: the orbit equations' Jacobian in (v, s, q) with the
+    phase condition, (n + 1) x (n + 2)."""
+    n = len(w)
+    A = np.zeros((n + 1, n + 2))
+    A[:n, :n] = J - np.eye(n)
+    A[:n, n], A[:n, n + 1] = w, col
+    A[n, :n] = w / max(np.linalg.norm(w), 1e-300)
+    return A
+
+
 def _near_one(o: Orbit, within: float = 0.15) -> bool:
     """Whether a real multiplier of ``o`` lies within ``within`` of +1 (as at a fold)."""
     m = o.multipliers
     return bool(np.any((np.abs(np.imag(m)) < 1e-9) & (np.abs(np.real(m) - 1.0) < within)))
-
-
-def _largest(o: Orbit) -> float:
-    return float(abs(o.multipliers[0])) if len(o.multipliers) else 0.0
 
 
 def _crossing_kind(unstable: Orbit) -> str:

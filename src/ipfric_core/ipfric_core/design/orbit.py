@@ -227,11 +227,11 @@ def return_map(loop: LoopNumbers, z: np.ndarray, level: float, crossings: int = 
                  stuck / max(n, 1), sticks, code)
 
 
-def sample_step(loop: LoopNumbers, z: np.ndarray) -> np.ndarray:
-    """The loop state one sample after ``z``."""
-    z = np.array(z, dtype=float)
-    _cycle(*loop.args(), z, math.inf, 0, 1, np.zeros(len(OUT)))
-    return z
+def motion(loop: LoopNumbers, z: np.ndarray, idx: np.ndarray) -> np.ndarray:
+    """The loop's motion at state ``z`` on the entries ``idx`` [per s]: one sample step over dt."""
+    after = np.array(z, dtype=float)
+    _cycle(*loop.args(), after, math.inf, 0, 1, np.zeros(len(OUT)))
+    return (after[idx] - z[idx]) / loop.dt
 
 
 class OrbitError(RuntimeError):
@@ -262,8 +262,13 @@ class Orbit:
     level: float = 0.0
 
     @property
+    def largest_multiplier(self) -> float:
+        """Modulus of the largest Floquet multiplier (0 without any)."""
+        return float(abs(self.multipliers[0])) if len(self.multipliers) else 0.0
+
+    @property
     def stable(self) -> bool:
-        return bool(len(self.multipliers) == 0 or abs(self.multipliers[0]) < 1.0)
+        return self.largest_multiplier < 1.0
 
     def summary(self) -> dict:
         m = self.multipliers[:4]
@@ -271,7 +276,7 @@ class Orbit:
                 'x_center_m': float(self.x_center), 'stuck_fraction': float(self.stuck_fraction),
                 'sticks_per_period': int(self.sticks), 'crossings_per_period': int(self.crossings),
                 'stable': self.stable, 'multipliers': [[float(v.real), float(v.imag)] for v in m],
-                'max_multiplier_modulus': float(abs(self.multipliers[0])) if len(m) else 0.0,
+                'max_multiplier_modulus': self.largest_multiplier,
                 'residual': float(self.residual), 'newton_iterations': int(self.iterations)}
 
 
@@ -290,7 +295,7 @@ def shoot(loop: LoopNumbers, z: np.ndarray, level: float, crossings: int = 1, to
     z = np.array(z, dtype=float)
     idx, scale = free_entries(loop, len(z)), entry_scale(loop, len(z))
     n = len(idx)
-    w = (sample_step(loop, z)[idx] - z[idx]) / loop.dt   # the loop's motion [per s]
+    w = motion(loop, z, idx)
     s = 0.0
     res = math.inf
     for it in range(1, max_iter + 1):
