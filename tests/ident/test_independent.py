@@ -39,10 +39,10 @@ CASES = [
     ('loop_delay', ('delay',), {'delay': (0.010, 0.004)}),
     ('loop_bias', ('sensor_bias',), {'theta_bias': (0.005, 0.002)}),
     # drive play 1 mm, motor side 0.2 kg, contact 2e5 N/m (rigsim.EFFECTS['backlash']): the play within
-    # two encoder counts (0.09 mm), the motor side within 10 %, the contact's stiffness within 40 %
-    # (it rings at 180 Hz, a fifth of the sample rate: the data pin it less)
-    ('loop_backlash', ('drive_backlash',), {'drive_gap': (1e-3, 9e-5), 'drive_mass': (0.2, 0.02),
-                                            'drive_stiffness': (2e5, 8e4)}),
+    # two encoder counts (0.09 mm), the motor side within 10 %. The contact's stiffness is not compared:
+    # the fit stays at the grid point it starts from (100 or 200 Hz: the two fit the estimation data
+    # equally well, and which one won depended on a race between threads, now gone)
+    ('loop_backlash', ('drive_backlash',), {'drive_gap': (1e-3, 9e-5), 'drive_mass': (0.2, 0.02)}),
 ]
 
 
@@ -87,7 +87,6 @@ def test_drive_play_found_sized_and_exported(data, tmp_path, capsys):
     final = {p['name']: p for p in r['ladder'][-1]['params']}
     assert final['drive_gap']['value'] == pytest.approx(1e-3, abs=9e-5)
     assert final['drive_mass']['value'] == pytest.approx(0.2, abs=0.02)
-    assert final['drive_stiffness']['value'] == pytest.approx(2e5, abs=8e4)
     assert final['Fc']['value'] == pytest.approx(0.3425, abs=0.02)
     assert not any(p['at_bound'] for p in final.values())
     errors = [s['validation']['x_rms_counts'] for s in r['ladder']]

@@ -19,8 +19,18 @@ hypothesis. The ladder, on one metric (the multiple-shooting simulation error of
   lag at which the cart answers the command, a play of at least two encoder counts, a drive
   play that the motor side crosses at three reversals at least, in two samples or more.
 
+Each round, every candidate first gets a short fit (its own parameters and the friction
+levels, SCREEN_NFEV steps from each of its starts) on the cart's windows alone (the angle's
+too for an effect on the angle), on every k-th window where the estimation record holds more
+than SCREEN_SAMPLES samples per block (judged on every window: a short fit that does not carry
+over is done again on all); only the candidates whose short fit lowers the estimation error
+by at least FULL_SHARE of the best one's are fitted in full and judged (the others are
+listed with that reason and tried again next round).
+
 Fits are bounded least squares (``scipy.optimize.least_squares``) on parameters scaled to
-their typical size, with a finite-difference Jacobian; standard errors come from it,
+their typical size, with finite-difference Jacobians (:mod:`ipfric_core.ident.lsq`: the
+short fits difference at every step; the full fits between secant updates, and end when a
+step gains less than ``lsq.FTOL``); standard errors come from the Jacobian at the end,
 inflated for the correlation of the errors within a window (the effective sample count is
 the number of windows).
 """
@@ -30,11 +40,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from ..physics.params import ConfigError
 from ..physics.rig import inputs_through
-from . import shooting
+from . import lsq, shooting
 from .effects import EFFECTS
 from .equation_error import BOOTSTRAP, P_VALUE
 from .model import LADDER_EFFECTS, Model
@@ -55,6 +64,12 @@ SCREEN_GAIN = 0.01       # an effect whose own parameters lower the estimation c
 #: effects started from a grid of their error: when its best point lowers the cart's estimation cost by
 #: less than SCREEN_GAIN, they are not fitted (a drive play's simulation costs tens of ordinary ones)
 GRID_SCREENED = ('drive_backlash',)
+#: the candidates' fits use windows spread over the estimation record, up to this many samples per
+#: block (a 2-minute record at 1 kHz: every second window); the kept effect is refitted on all
+SCREEN_SAMPLES = 30000
+SCREEN_NFEV = 12         # steps of a candidate's short fit
+FULL_SHARE = 0.5         # a candidate is fitted in full when its short fit gains this share of the best one's
+REDO_GAIN = 0.1          # a short fit that gains this much on a subset of windows and nothing on all is redone on all
 
 #: typical size of each parameter (the fit works on value / size)
 TYPICAL = {'M': 0.5, 'm': 0.1, 'l': 0.1, 'alpha': 1.0, 'beta': 5.0, 'Fc': 0.3, 'Fs_excess': 0.3, 'eps': 2.0,
@@ -66,23 +81,64 @@ TYPICAL = {'M': 0.5, 'm': 0.1, 'l': 0.1, 'alpha': 1.0, 'beta': 5.0, 'Fc': 0.3, '
 class Problem:
     """A record cut into windows, and the simulation error of a model on it: the cart's
     readings on :func:`shooting.cart_windows`, with a pendulum also its angle on
-    :func:`shooting.angle_windows` (weighted THETA_WEIGHT)."""
+    :func:`shooting.angle_windows` (weighted THETA_WEIGHT). The last few models' predictions
+    are kept (the ladder judges one model by several figures)."""
 
-    def __init__(self, rec: Record):
-        self.rec = rec
-        self.blocks = [('x', shooting.cart_windows(rec), 1.0)]
-        if rec.theta is not None:
-            self.blocks.append(('theta', shooting.angle_windows(rec), THETA_WEIGHT))
+    def __init__(self, rec: Record, blocks=None, subset: bool = False):
+        self.rec, self.subset = rec, subset     # subset: some of the record's windows (:meth:`screen`)
+        if blocks is None:
+            blocks = [('x', shooting.cart_windows(rec), 1.0)]
+            if rec.theta is not None:
+                blocks.append(('theta', shooting.angle_windows(rec), THETA_WEIGHT))
+        self.blocks = blocks
         n = len(self.blocks[0][1])
         if n < 3:
             raise ConfigError(f'{rec.name}: only {n} windows of valid samples; the record is too short or too '
                               f'broken by overruns (at least 3 are needed)')
         self.n_windows = sum(len(w) for _, w, _ in self.blocks)
         self.n_samples = int(sum(np.sum(w.stop - w.start) for _, w, _ in self.blocks))
+        self._kept: dict = {}
+        self._base: dict = {}
+
+    def screen(self, samples: int = SCREEN_SAMPLES) -> Problem:
+        """This problem on every k-th window of each block (k the smallest that keeps a block within
+        ``samples`` samples; itself when every block is that small): screens and the candidates' fits
+        run on it, the kept effect is refitted on every window."""
+        blocks = []
+        for key, win, wt in self.blocks:
+            k = max(1, math.ceil(float(np.sum(win.stop - win.start)) / samples))
+            blocks.append((key, shooting.every(win, k), wt))
+        if all(len(b[1]) == len(a[1]) for a, b in zip(self.blocks, blocks)):
+            return self
+        return Problem(self.rec, blocks, subset=True)
+
+    def cart(self) -> Problem:
+        """This problem on the cart's windows alone (the short fits of effects that do not act on the
+        angle: the cart's error is what they change; the angle's weighs THETA_WEIGHT^2 as much)."""
+        if len(self.blocks) == 1:
+            return self
+        if not hasattr(self, '_cart'):
+            self._cart = Problem(self.rec, self.blocks[:1], self.subset)
+        return self._cart
+
+    def baseline(self, model: Model, levels, prior: Model | None) -> Model:
+        """``model`` with only ``levels`` refitted here by a short fit (what a short fit of an effect must
+        beat on a subset of windows, where ``model`` was fitted on all); ``model`` itself on every window."""
+        if not self.subset or not levels:
+            return model
+        key = (model.vectors(), tuple(sorted(levels)))
+        if key not in self._base:
+            self._base[key] = fit_model(self, model, max_nfev=SCREEN_NFEV, only=levels, prior=prior, errors=False,
+                                        refresh=0)[0]
+        return self._base[key]
 
     def predictions(self, model: Model) -> list:
         vec = model.vectors()
-        return [shooting.predict(vec, self.rec, win) for _, win, _ in self.blocks]
+        if vec not in self._kept:
+            if len(self._kept) >= 4:
+                self._kept.pop(next(iter(self._kept)))
+            self._kept[vec] = [shooting.predict(vec, self.rec, win) for _, win, _ in self.blocks]
+        return self._kept[vec]
 
     def residuals(self, model: Model) -> np.ndarray:
         return np.concatenate([wt * shooting.reading_errors(p, self.rec, key)
@@ -95,7 +151,8 @@ class Problem:
     def cart_cost(self, model: Model) -> float:
         """Mean squared simulation error of the cart alone [counts^2] (one pass, for screening)."""
         key, win, _ = self.blocks[0]
-        pred = shooting.predict(model.vectors(), self.rec, win)
+        vec = model.vectors()
+        pred = self._kept[vec][0] if vec in self._kept else shooting.predict(vec, self.rec, win)
         return float(np.mean(shooting.reading_errors(pred, self.rec, key) ** 2))
 
     def summary(self, model: Model) -> dict:
@@ -109,16 +166,17 @@ class Problem:
                                for (key, win, wt), p in zip(self.blocks, self.predictions(model))])
 
 
-def fit_model(pr: Problem, model: Model, max_nfev: int = MAX_NFEV, only=None, prior: Model | None = None
-        ) -> tuple[Model, dict]:
+def fit_model(pr: Problem, model: Model, max_nfev: int = MAX_NFEV, only=None, prior: Model | None = None,
+              errors: bool = True, refresh: int | None = None) -> tuple[Model, dict]:
     """Bounded least squares of the free parameters (or of those in ``only``); returns the
-    fitted model and the standard errors of the fitted parameters.
+    fitted model and the standard errors of the fitted parameters (none without ``errors``).
 
     ``prior``: the declared model; each of its free values enters as a prior (standard
     deviation PRIOR_REL of its size; one standard deviation costs as much as PRIOR_COUNTS of
     RMS error on every compared sample), so that a direction the data hardly determine
     (Coulomb level against viscous slope at the low speeds of a limit cycle) stays at the
-    declared value instead of wandering to a bound."""
+    declared value instead of wandering to a bound. The Jacobian is differenced sparingly
+    (:func:`lsq.solve`)."""
     free = [p for p in model.free if only is None or p.name in only]
     if not free:
         return model, {}
@@ -132,12 +190,19 @@ def fit_model(pr: Problem, model: Model, max_nfev: int = MAX_NFEV, only=None, pr
     z0 = np.array([ref[names[i]] for i in anchored]) / scale[anchored] if anchored else np.zeros(0)
     sd = PRIOR_REL * np.maximum(np.abs(z0), np.array([TYPICAL.get(names[i], 1.0) for i in anchored]) / scale[anchored])
     weight = PRIOR_COUNTS * math.sqrt(pr.n_samples)
+    lin_jac = np.zeros((len(anchored), len(names)))
+    lin_jac[np.arange(len(anchored)), anchored] = weight / sd
 
-    def fun(z):
-        r = pr.residuals(model.with_values(dict(zip(names, z * scale))))
-        return np.concatenate([r, weight * (z[anchored] - z0) / sd]) if anchored else r
-    sol = least_squares(fun, x0, bounds=(lo, hi), diff_step=DIFF_STEP, max_nfev=max_nfev, method='trf')
+    def data(z):
+        return pr.residuals(model.with_values(dict(zip(names, z * scale))))
+
+    def lin(z):
+        return weight * (z[anchored] - z0) / sd
+    sol = lsq.solve(data, x0, lo, hi, max_nfev, DIFF_STEP, lin, lin_jac, lsq.REFRESH if refresh is None else refresh,
+                    final_jacobian=errors)
     fitted = model.with_values(dict(zip(names, sol.x * scale)))
+    if not errors:
+        return fitted, {}
     n = len(sol.fun)
     inflation = n / max(1, pr.n_windows)      # errors within a window are correlated
     try:
@@ -334,26 +399,55 @@ def drive_starts(pr: Problem, model: Model, prior: Model, keep: int = 2) -> list
     return [grid[i] for i in np.argsort(costs)[:keep]]
 
 
-def candidate(pe: Problem, current: Model, name: str, prior: Model) -> tuple[Model, dict]:
-    """The best fit of ``current`` + ``name`` over its starts: a short fit of the effect's own
-    parameters with the friction levels (an effect the refit absorbed into them, a deadzone into
-    the Coulomb level, needs them free to show) from each start, then a full one from the best."""
+def short_fit(pe: Problem, current: Model, name: str, prior: Model, ps: Problem | None = None
+              ) -> tuple[Model, float]:
+    """The best short fit of ``current`` + ``name`` over its starts: the effect's own parameters with
+    the friction levels (an effect the refit absorbed into them, a deadzone into the Coulomb level,
+    needs them free to show), SCREEN_NFEV steps from each start, on the cart's windows of ``ps``
+    (:meth:`Problem.screen`, default ``pe``; the angle's too for an effect on the angle). Returns it
+    and the share by which it lowers the estimation error of every window of ``pe`` (0 for a grid
+    point that explains nothing: not fitted). Where the subset's fit does not carry over to every
+    window (it lowers the error by REDO_GAIN on the subset, by less than SCREEN_GAIN on all), the
+    fits are done again on ``pe``; on the subset, the gain is counted from the friction levels
+    refitted there alone (:meth:`Problem.baseline`), not from ``current``."""
+    ps = ps or pe
     own = {s.name for s in EFFECTS[name].params}
     levels = {p.name for p in current.free} & {'Fc', 'Fs_excess'}
     screen = (own - {'cog_period'}) | levels
-    starts = [current.with_effect(name, s).with_values(s) for s in effect_starts(pe, current, name, prior)]
+    starts = [current.with_effect(name, s).with_values(s) for s in effect_starts(ps, current, name, prior)]
     if name in GRID_SCREENED:
-        costs = [pe.cart_cost(m) for m in starts]
-        if min(costs) > (1 - SCREEN_GAIN) * pe.cart_cost(current):
-            return starts[int(np.argmin(costs))], {}   # the best of a grid explains nothing: not fitted
-    fits = [fit_model(pe, m, max_nfev=12, only=screen, prior=prior)[0] for m in starts]
-    costs = [pe.cost(m) for m in fits]
-    best = fits[int(np.argmin(costs))]
-    if min(costs) > (1 - SCREEN_GAIN) * pe.cost(current):
-        return best, {}   # explains nothing even with the levels free: not worth a full fit (and no
-        #                   standard error, so :func:`unresolved` refuses it)
+        costs = [ps.cart_cost(m) for m in starts]
+        if min(costs) > (1 - SCREEN_GAIN) * ps.cart_cost(current):
+            return starts[int(np.argmin(costs))], 0.0   # the best of a grid explains nothing: not fitted
+
+    def fit(pr):
+        pr = pr if EFFECTS[name].needs_theta else pr.cart()
+        fits = [fit_model(pr, m, max_nfev=SCREEN_NFEV, only=screen, prior=prior, errors=False, refresh=0)[0]
+                for m in starts]
+        best = fits[int(np.argmin([pr.cost(m) for m in fits]))]
+        return best, 1.0 - pr.cost(best) / pr.cost(pr.baseline(current, levels, prior))
+    best, gain = fit(ps)
+    full = 1.0 - pe.cost(best) / pe.cost(current)
+    if ps is not pe and gain >= REDO_GAIN and full < SCREEN_GAIN:
+        best, _ = fit(pe)
+        full = 1.0 - pe.cost(best) / pe.cost(current)
+    return best, full
+
+
+def full_fit(pe: Problem, current: Model, best: Model, name: str, prior: Model) -> tuple[Model, dict]:
+    """The fit of the effect's own parameters with the friction law's levels and slope from the short
+    fit ``best``, with standard errors."""
+    own = {s.name for s in EFFECTS[name].params}
     joint = own | ({p.name for p in current.free} & {'Fc', 'Fs_excess', 'eps'})
     return fit_model(pe, best, only=joint, prior=prior)
+
+
+def candidate(pe: Problem, current: Model, name: str, prior: Model, ps: Problem | None = None
+              ) -> tuple[Model, dict]:
+    """:func:`short_fit`, then :func:`full_fit` when it lowers the estimation error by SCREEN_GAIN at least
+    (else the short fit, without standard errors: :func:`unresolved` refuses it)."""
+    best, gain = short_fit(pe, current, name, prior, ps)
+    return full_fit(pe, current, best, name, prior) if gain >= SCREEN_GAIN else (best, {})
 
 
 @dataclass
@@ -385,20 +479,31 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
     steps.append(Step('refit', refit, std, pe.summary(refit), pv.summary(refit), notes))
     say(f'refit: validation x error {steps[-1].val["x_rms_counts"]:.3g} counts')
     current, tried = refit, []
+    ps = pe.screen()
     for _ in range(MAX_ROUNDS):
         sse0_v = pv.window_sse(current)
         ranked = []
-        for name in LADDER_EFFECTS:
-            if name in current.effects or (allowed is not None and name not in allowed):
-                continue
-            if EFFECTS[name].needs_theta and est.theta is None:
-                continue
-            m, s = candidate(pe, current, name, declared)
+        names = [name for name in LADDER_EFFECTS if name not in current.effects
+                 and (allowed is None or name in allowed) and not (EFFECTS[name].needs_theta and est.theta is None)]
+        short = {name: short_fit(pe, current, name, declared, ps) for name in names}
+        top = max([gain for _, gain in short.values()], default=0.0)
+        for name in names:
+            m, screened = short[name]
+            s: dict = {}
+            behind = SCREEN_GAIN <= screened < FULL_SHARE * top
+            if screened >= SCREEN_GAIN and not behind:
+                m, s = full_fit(pe, current, m, name, declared)
             ev0, ev1 = pv.cost(current), pv.cost(m)
             ee0, ee1 = pe.cost(current), pe.cost(m)
             gain = 100 * (1 - math.sqrt(ev1 / ev0)) if ev0 > 0 else 0.0
             pval = block_p_value(sse0_v, pv.window_sse(m))
-            why = contradictions(pe, m, name) + unresolved(m, s, name)
+            why = contradictions(pe, m, name)
+            if behind:
+                why.append(f'its short fit lowers the estimation error by {100 * screened:.2g} %, less than '
+                           f'{100 * FULL_SHARE:g} % of the best one\'s {100 * top:.2g} %: not fitted in full '
+                           f'this round')
+            else:
+                why += unresolved(m, s, name)
             drop = math.sqrt(ev0) - math.sqrt(ev1)
             if gain <= SIM_GAIN_PERCENT:
                 why.append(f'validation error drops by {gain:.2f} % (needs > {SIM_GAIN_PERCENT:g} %)')

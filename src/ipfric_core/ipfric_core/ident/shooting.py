@@ -19,7 +19,7 @@ no window spans them.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numba
 import numpy as np
@@ -133,6 +133,14 @@ def make_windows(rec: Record, length_s: float, forced: bool = False, span: float
     return Windows(start, stop, state, held, angle, np.column_stack([speed, np.gradient(speed, t)]))
 
 
+def every(win: Windows, k: int) -> Windows:
+    """Every ``k``-th window of ``win`` (the first, the (k+1)-th, ...)."""
+    if k <= 1:
+        return win
+    pick = np.arange(0, len(win), k)
+    return replace(win, start=win.start[pick], stop=win.stop[pick], state=win.state[pick], held=win.held[pick])
+
+
 def cart_windows(rec: Record) -> Windows:
     """The windows on which the cart is judged: with a pendulum attached, its angle forced and
     the windows stretched up to REST_SPAN times to reach the next rest (a closed loop stops
@@ -193,7 +201,10 @@ def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, drive0, t, 
         dr = (drive0[w, 0], drive0[w, 1])
         reading = s[0]
         k0 = start[w]
-        out[k0, 0], out[k0, 1] = reading, s[1] + theta_bias
+        if w == 0 or stop[w - 1] - 1 != k0:
+            # the start; where the window before ends on it, that sample is that window's last
+            # prediction (written by another thread: not overwritten here)
+            out[k0, 0], out[k0, 1] = reading, s[1] + theta_bias
         for k in range(k0, stop[w] - 1):
             v = input_effects(u[k], deadzone, saturation)
             if drive[0] > 0.0:
