@@ -169,7 +169,8 @@ class Problem:
 def fit_model(pr: Problem, model: Model, max_nfev: int = MAX_NFEV, only=None, prior: Model | None = None,
               errors: bool = True, refresh: int | None = None) -> tuple[Model, dict]:
     """Bounded least squares of the free parameters (or of those in ``only``); returns the
-    fitted model and the standard errors of the fitted parameters (none without ``errors``).
+    fitted model and the standard errors of the fitted parameters with their covariance
+    (:class:`Errors`; none without ``errors``).
 
     ``prior``: the declared model; each of its free values enters as a prior (standard
     deviation PRIOR_REL of its size; one standard deviation costs as much as PRIOR_COUNTS of
@@ -204,14 +205,37 @@ def fit_model(pr: Problem, model: Model, max_nfev: int = MAX_NFEV, only=None, pr
     if not errors:
         return fitted, {}
     n = len(sol.fun)
-    inflation = n / max(1, pr.n_windows)      # errors within a window are correlated
+    # one standard deviation of the sum of squares: its residual variance, times the samples per window
+    # (the errors within a window are correlated: the windows count as the independent samples)
+    level = float(sol.fun @ sol.fun) / max(1, n - len(names)) * n / max(1, pr.n_windows)
     try:
-        J = sol.jac / scale
-        cov = np.linalg.pinv(J.T @ J) * float(sol.fun @ sol.fun) / max(1, n - len(names)) * inflation
-        std = np.sqrt(np.maximum(np.diag(cov), 0.0))
+        # in the scaled parameters (each about 1): in physical units the columns span ten decades (a
+        # contact stiffness of 1e5 N/m beside a play of 1e-3 m) and pinv dropped the stiffest as noise
+        cov = np.linalg.pinv(sol.jac.T @ sol.jac) * level
     except np.linalg.LinAlgError:
-        std = np.full(len(names), np.nan)
-    return fitted, dict(zip(names, map(float, std)))
+        return fitted, Errors(names, np.full((len(names), len(names)), np.nan))
+    return fitted, Errors(names, cov * np.outer(scale, scale))
+
+
+class Errors(dict):
+    """Standard errors of fitted parameters by name (a dict), with their covariance (``names``,
+    ``cov``, physical units)."""
+
+    def __init__(self, names, cov):
+        super().__init__(zip(names, map(float, np.sqrt(np.maximum(np.diag(cov), 0.0)))))
+        self.names, self.cov = list(names), np.asarray(cov, float)
+
+    def correlations(self, threshold: float = 0.0) -> list[tuple[str, str, float]]:
+        """(a, b, r) of every pair whose correlation is at least ``threshold`` in size, largest first."""
+        sd = np.sqrt(np.maximum(np.diag(self.cov), 0.0))
+        out = []
+        for i in range(len(self.names)):
+            for j in range(i + 1, len(self.names)):
+                if sd[i] > 0 and sd[j] > 0:
+                    r = float(self.cov[i, j] / (sd[i] * sd[j]))
+                    if abs(r) >= threshold:
+                        out.append((self.names[i], self.names[j], r))
+        return sorted(out, key=lambda t: -abs(t[2]))
 
 
 def block_p_value(before: np.ndarray, after: np.ndarray) -> float:
