@@ -30,9 +30,10 @@ listed with that reason and tried again next round).
 Fits are bounded least squares (``scipy.optimize.least_squares``) on parameters scaled to
 their typical size, with finite-difference Jacobians (:mod:`ipfric_core.ident.lsq`: the
 short fits difference at every step; the full fits between secant updates, and end when a
-step gains less than ``lsq.FTOL``); standard errors come from the Jacobian at the end,
-inflated for the correlation of the errors within a window (the effective sample count is
-the number of windows).
+step gains less than ``lsq.FTOL``); standard errors come from the Jacobian at the end (in the
+scaled parameters), inflated for the correlation of the errors within a window (the effective
+sample count is the number of windows), and from a scan along a parameter where the error is
+rough in it or rises slower than a quadratic (:class:`Errors`, :func:`lsq.scan_errors`).
 """
 from __future__ import annotations
 
@@ -167,10 +168,11 @@ class Problem:
 
 
 def fit_model(pr: Problem, model: Model, max_nfev: int = MAX_NFEV, only=None, prior: Model | None = None,
-              errors: bool = True, refresh: int | None = None) -> tuple[Model, dict]:
+              errors: bool = True, refresh: int | None = None, profile=None) -> tuple[Model, dict]:
     """Bounded least squares of the free parameters (or of those in ``only``); returns the
-    fitted model and the standard errors of the fitted parameters with their covariance
-    (:class:`Errors`; none without ``errors``).
+    fitted model and the standard errors of the fitted parameters (:class:`Errors`; none without
+    ``errors``): the Jacobian's, checked along each parameter (of ``profile``, default all) for a
+    rough or flatter than quadratic sum of squares, and then from a scan along it.
 
     ``prior``: the declared model; each of its free values enters as a prior (standard
     deviation PRIOR_REL of its size; one standard deviation costs as much as PRIOR_COUNTS of
@@ -214,16 +216,40 @@ def fit_model(pr: Problem, model: Model, max_nfev: int = MAX_NFEV, only=None, pr
         cov = np.linalg.pinv(sol.jac.T @ sol.jac) * level
     except np.linalg.LinAlgError:
         return fitted, Errors(names, np.full((len(names), len(names)), np.nan))
-    return fitted, Errors(names, cov * np.outer(scale, scale))
+    se = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    # where the Jacobian's errors are not to be trusted: a rough error (forward and backward differences
+    # unlike), or one that does not rise as a quadratic would; there a scan along the parameter decides
+    cols = [i for i, nm in enumerate(names) if profile is None or nm in profile]
+    r0 = sol.fun[:len(sol.fun) - len(anchored)]
+    cosine = lsq.rough(sol.difference, sol.x, r0, np.full(len(names), 0.1 * DIFF_STEP), cols)
+    rough = [i for i in cols if cosine[i] < lsq.ROUGH_COSINE]
+    seen: dict = {}
+
+    def objective(z):
+        if z.tobytes() not in seen:
+            r, q = data(z), lin(z)
+            seen[z.tobytes()] = float(r @ r + q @ q)
+        return seen[z.tobytes()]
+    at = float(sol.fun @ sol.fun)
+    flat = lsq.quadratic(objective, sol.x, lo, hi, se, level, at, [i for i in cols if i not in rough])
+    wide, reach = lsq.scan_errors(objective, sol.x, lo, hi, se, level, at, sorted(rough + flat))
+    widen = np.where(se > 0, wide / np.where(se > 0, se, 1.0), 1.0)
+    cov = cov * np.outer(widen, widen) * np.outer(scale, scale)
+    return fitted, Errors(names, cov, {nm: r for nm, r in zip(names, reach) if r}, [names[i] for i in rough],
+                          [names[i] for i in flat])
 
 
 class Errors(dict):
     """Standard errors of fitted parameters by name (a dict), with their covariance (``names``,
-    ``cov``, physical units)."""
+    ``cov``, physical units), the parameters on which the simulated error is rough (``rough``) or rises
+    slower than a quadratic (``flat``: both with errors from :func:`lsq.scan_errors`, their
+    correlations stay the Jacobian's) and those whose scan stayed low up to a bound (``reach``: name
+    -> 'lo'/'hi'/'both'): the data do not confine them."""
 
-    def __init__(self, names, cov):
+    def __init__(self, names, cov, reach=None, rough=(), flat=()):
         super().__init__(zip(names, map(float, np.sqrt(np.maximum(np.diag(cov), 0.0)))))
-        self.names, self.cov = list(names), np.asarray(cov, float)
+        self.names, self.cov, self.reach = list(names), np.asarray(cov, float), dict(reach or {})
+        self.rough, self.flat = list(rough), list(flat)
 
     def correlations(self, threshold: float = 0.0) -> list[tuple[str, str, float]]:
         """(a, b, r) of every pair whose correlation is at least ``threshold`` in size, largest first."""
@@ -463,7 +489,7 @@ def full_fit(pe: Problem, current: Model, best: Model, name: str, prior: Model) 
     fit ``best``, with standard errors."""
     own = {s.name for s in EFFECTS[name].params}
     joint = own | ({p.name for p in current.free} & {'Fc', 'Fs_excess', 'eps'})
-    return fit_model(pe, best, only=joint, prior=prior)
+    return fit_model(pe, best, only=joint, prior=prior, profile=SIZE.get(name, ()))
 
 
 def candidate(pe: Problem, current: Model, name: str, prior: Model, ps: Problem | None = None

@@ -22,9 +22,15 @@ CHI2_2D_95 = 5.991   # chi-square quantile of a 95 % joint region of two paramet
 
 
 def param_table(step: Step) -> list[dict]:
-    """Every parameter of a step: value, standard error (fitted ones), unit, fitted or known."""
+    """Every parameter of a step: value, standard error (fitted ones), unit, fitted or known, and
+    whether its error comes from a scan along it, the simulated error being rough in it (``rough``) or
+    flatter than a quadratic on a side (``flat``), and whether the scan stayed low up to a bound
+    (``unconfined``: 'lo', 'hi' or 'both')."""
+    rough, flat = getattr(step.std, 'rough', ()), getattr(step.std, 'flat', ())
+    reach = getattr(step.std, 'reach', {})
     return [{'name': p.name, 'value': p.value, 'std': step.std.get(p.name), 'unit': p.unit,
-             'fitted': p.free, 'at_bound': p.at_bound(1e-3 * TYPICAL.get(p.name, 1.0)), 'doc': p.doc}
+             'fitted': p.free, 'at_bound': p.at_bound(1e-3 * TYPICAL.get(p.name, 1.0)), 'doc': p.doc,
+             'rough': p.name in rough, 'flat': p.name in flat, 'unconfined': reach.get(p.name, '')}
             for p in step.model.params]
 
 
@@ -184,7 +190,10 @@ def ladder_markdown(r: dict) -> str:
     for s in r['ladder']:
         lines += [f'### {s["step"]}', '', '| parameter | value | unit | fitted | |', '| --- | --- | --- | --- | --- |']
         for p in s['params']:
-            flag = 'on a bound' if p['at_bound'] else ''
+            flag = '; '.join(f for f in ('on a bound' if p['at_bound'] else '',
+                                         'rough: error from a scan' if p.get('rough') else '',
+                                         'flat profile: error from a scan' if p.get('flat') else '',
+                                         f'not confined ({p["unconfined"]})' if p.get('unconfined') else '') if f)
             lines.append(f'| {p["name"]} | {_fmt(p)} | {p["unit"]} | {"yes" if p["fitted"] else "known"} | {flag} |')
         units = {p['name']: p['unit'] for p in s['params']}
         notes = s['notes'] + correlation_lines(s, units)

@@ -67,12 +67,13 @@ class _Secant:
         self.trials.append((x.copy(), r))
         return np.concatenate([r, self.lin_rows(x)])
 
-    def difference(self, x, r0, step=None):
+    def difference(self, x, r0, step=None, cols=None):
         """Forward differences, each step ``step`` (default the fit's) relative to max(1, |x|), turned back
-        inside the bounds (as scipy's '2-point' scheme)."""
+        inside the bounds (as scipy's '2-point' scheme); of the columns ``cols`` only (default all, the
+        others zero)."""
         step = self.step if step is None else step
-        J = np.empty((len(r0), len(x)))
-        for i in range(len(x)):
+        J = np.zeros((len(r0), len(x)))
+        for i in range(len(x)) if cols is None else cols:
             h = step[i] * max(1.0, abs(x[i]))
             if not self.lo[i] <= x[i] + h <= self.hi[i]:
                 h = -h
@@ -135,3 +136,98 @@ def solve(data, x0, lo, hi, max_nfev: int, step, lin_rows=None, lin_jac=None, re
         s.J, s.age, s.at = s.difference(x, r), 0, (x.copy(), r)
     jac = np.vstack([s.J, lin_jac]) if s.J is not None else np.vstack([s.difference(x, r), lin_jac])
     return Solution(x, np.concatenate([r, lin_rows(x)]), jac, s.evaluations, status, s.difference)
+
+
+ROUGH_COSINE = 0.8      # forward and backward differences less alike than this: the error is rough there
+PROBE_SIGMAS = 2.0      # the sum of squares is probed this many standard errors each way along each parameter
+QUADRATIC_RISE = 2.0    # and must rise by this many levels there (a quadratic one rises by 4)
+SCAN_SIGMAS = 2.0       # a rough parameter's error: half the reach of the region where the sum of squares
+SCAN_STOP = 9.0         # rises by less than SCAN_SIGMAS^2 levels; a side ends after two probes above SCAN_STOP levels
+SCAN_REACH = 2.0        # or at this distance (scaled units: twice the parameter's size)
+
+
+def rough(difference, x, r0, step, cols):
+    """Cosine between forward and backward differences of the data rows ``r0`` at ``x`` with the
+    relative ``step`` (a tenth of the fit's: small enough that a smooth but strongly nonlinear
+    parameter, a ripple's period over many periods, still differences alike both ways), for the
+    parameters ``cols`` (1 for the others): near 1 where the simulated error is smooth in a
+    parameter; where the simulation depends on it chaotically (a drive's contact ringing through
+    many knocks) the two are unrelated."""
+    ahead = difference(x, r0, np.asarray(step), cols)
+    back = difference(x, r0, -np.asarray(step), cols)
+    num = np.sum(ahead * back, axis=0)
+    den = np.linalg.norm(ahead, axis=0) * np.linalg.norm(back, axis=0)
+    return np.where(den > 0, num / np.where(den > 0, den, 1.0), 1.0)
+
+
+def quadratic(objective, x, lo, hi, se, level: float, at: float, cols):
+    """The parameters of ``cols`` along which the sum of squares ``objective`` (``at`` at ``x``) does not
+    rise by QUADRATIC_RISE levels at PROBE_SIGMAS standard errors ``se`` each way, the others fixed (a
+    quadratic sum of squares rises by PROBE_SIGMAS^2 levels there, more where parameters are
+    correlated): there the Jacobian's error is too small (a profile with a long flat side)."""
+    out = []
+    for i in cols:
+        if not (np.isfinite(se[i]) and se[i] > 0):
+            continue
+        for sign, bound in ((1.0, hi[i]), (-1.0, lo[i])):
+            d = min(PROBE_SIGMAS * se[i], abs(bound - x[i]))
+            if d <= 0.0:
+                continue
+            xi = x.copy()
+            xi[i] += sign * d
+            if objective(xi) - at < QUADRATIC_RISE * level:
+                out.append(i)
+                break
+    return out
+
+
+def scan_errors(objective, x, lo, hi, se, level: float, at: float, which):
+    """Errors of the parameters ``which`` from the sum of squares ``objective`` along each alone (the
+    Jacobian's errors ``se`` mean nothing where the error is rough: it measures how much the
+    prediction changes, not whether it gets worse). Each side is probed at distances doubling from
+    max(2 se, 0.01) up to SCAN_REACH or the bound. A rough sum of squares jitters between nearby
+    values by more than its statistical level: the jitter (RMS of the rises at the two nearest
+    probes each side about the best c d^2 through them) counts as a level too. The error is half
+    the farthest probe where the sum of squares (``at`` at ``x``) rose by less than SCAN_SIGMAS^2
+    levels (or SCAN_SIGMAS jitters), no less than ``se``; a side ends after two probes above
+    SCAN_STOP levels (and three jitters). Returns the errors and, per parameter, '' or the bound(s)
+    that a low probe reached ('lo', 'hi', 'both')."""
+    out, reach = np.array(se, float), [''] * len(x)
+    for i in which:
+        sides: list = []
+        for sign, bound in ((1.0, hi[i]), (-1.0, lo[i])):
+            room = min(abs(bound - x[i]), SCAN_REACH)
+            first = max(2.0 * (se[i] if np.isfinite(se[i]) else 0.0), 0.01)
+            steps: list = []
+            while room > 0.0 and (not steps or steps[-1] < room):
+                steps.append(min(first * 2.0 ** len(steps), room))
+            sides.append((sign, steps, abs(bound - x[i]) <= SCAN_REACH, []))
+
+        def probe(sign, step, i=i):
+            xi = x.copy()
+            xi[i] += sign * step
+            return (objective(xi) - at) / level
+        for sign, steps, _, rises in sides:
+            rises += [probe(sign, d) for d in steps[:2]]
+        # the jitter: what a rise growing with the squared distance does not explain at the near probes
+        near = np.array([(d, r) for _, steps, _, rises in sides for d, r in zip(steps, rises)]).reshape(-1, 2)
+        jitter = 0.0
+        if len(near):
+            d2 = near[:, 0] ** 2
+            c = float(d2 @ near[:, 1] / (d2 @ d2))
+            jitter = float(np.sqrt(np.mean((near[:, 1] - c * d2) ** 2)))
+        want, stop = max(SCAN_SIGMAS ** 2, SCAN_SIGMAS * jitter), max(SCAN_STOP, 3.0 * jitter)
+        far, hit = 0.0, []
+        for sign, steps, bounded, rises in sides:
+            for d in steps[len(rises):]:
+                if len(rises) >= 2 and min(rises[-2:]) >= stop:
+                    break
+                rises.append(probe(sign, d))
+            low = [d for d, r in zip(steps, rises) if r < want]
+            if low:
+                far = max(far, max(low))
+                if bounded and max(low) >= steps[-1] and len(rises) == len(steps):
+                    hit.append('hi' if sign > 0 else 'lo')
+        out[i] = max(out[i] if np.isfinite(out[i]) else 0.0, far / SCAN_SIGMAS)
+        reach[i] = 'both' if len(hit) == 2 else (hit[0] if hit else '')
+    return out, reach
