@@ -28,9 +28,8 @@ by at least FULL_SHARE of the best one's are fitted in full and judged (the othe
 listed with that reason and tried again next round).
 
 Fits are bounded least squares (``scipy.optimize.least_squares``) on parameters scaled to
-their typical size, with finite-difference Jacobians (:mod:`ipfric_core.ident.lsq`: the
-short fits difference at every step; the full fits between secant updates, and end when a
-step gains less than ``lsq.FTOL``); standard errors come from the Jacobian at the end (in the
+their typical size, with finite-difference Jacobians (:mod:`ipfric_core.ident.lsq`; they end
+when a step gains less than ``lsq.FTOL``); standard errors come from the Jacobian at the end (in the
 scaled parameters), inflated for the correlation of the errors within a window (the effective
 sample count is the number of windows), and from a scan along a parameter where the error is
 rough in it or rises slower than a quadratic (:class:`Errors`, :func:`lsq.scan_errors`).
