@@ -39,11 +39,15 @@ CASES = [
     ('loop_delay', ('delay',), {'delay': (0.010, 0.004)}),
     ('loop_bias', ('sensor_bias',), {'theta_bias': (0.005, 0.002)}),
     # drive play 1 mm, motor side 0.2 kg, contact 2e5 N/m (rigsim.EFFECTS['backlash']): the play within
-    # two encoder counts (0.09 mm), the motor side within 10 %, the contact's stiffness within 40 %
-    # (it rings at 180 Hz, a fifth of the sample rate: the data pin it less)
-    ('loop_backlash', ('drive_backlash',), {'drive_gap': (1e-3, 9e-5), 'drive_mass': (0.2, 0.02),
-                                            'drive_stiffness': (2e5, 8e4)}),
+    # two encoder counts (0.09 mm), the motor side within 10 %. The contact's stiffness and damping are
+    # not compared: in the closed loop the simulated error is rough in every parameter (the contact
+    # rings through many knocks: forward and backward differences disagree) and the fit stays at the
+    # grid point it starts from (100 or 200 Hz, the two fit the estimation data equally well; which
+    # one won used to depend on a race between threads); the report flags them (ROUGH below)
+    ('loop_backlash', ('drive_backlash',), {'drive_gap': (1e-3, 9e-5), 'drive_mass': (0.2, 0.02)}),
 ]
+#: parameters whose simulated error must be reported rough (their errors from a scan, not the Jacobian)
+ROUGH = {'loop_backlash': {'drive_stiffness', 'drive_damping'}}
 
 
 @pytest.fixture(scope='module')
@@ -68,6 +72,7 @@ def test_undeclared_effect_in_independent_data(data, case, kept, expect):
         got = key(final) if callable(key) else final[key]
         assert got == pytest.approx(value, abs=tol), key
     assert not [p.name for p in final.params if p.at_bound(1e-3 * TYPICAL.get(p.name, 1.0))]
+    assert ROUGH.get(case, set()) <= set(res['steps'][-1].std.rough)
     errors = [s.val['x_rms_counts'] for s in res['steps']]
     assert errors[-1] <= errors[1] * 1.02          # the ladder never ends worse than the refit
     if kept:
@@ -87,7 +92,11 @@ def test_drive_play_found_sized_and_exported(data, tmp_path, capsys):
     final = {p['name']: p for p in r['ladder'][-1]['params']}
     assert final['drive_gap']['value'] == pytest.approx(1e-3, abs=9e-5)
     assert final['drive_mass']['value'] == pytest.approx(0.2, abs=0.02)
-    assert final['drive_stiffness']['value'] == pytest.approx(2e5, abs=8e4)
+    # the contact's stiffness and damping: the truth within three standard errors (honest errors: the
+    # Jacobian's in the scaled parameters, and a scan of the error where it is rough)
+    for name, truth in (('drive_stiffness', 2e5), ('drive_damping', 50.0), ('drive_gap', 1e-3), ('drive_mass', 0.2)):
+        assert abs(final[name]['value'] - truth) <= 3 * final[name]['std'], (name, final[name])
+        assert final[name]['std'] < abs(truth), (name, final[name])     # and not merely unbounded
     assert final['Fc']['value'] == pytest.approx(0.3425, abs=0.02)
     assert not any(p['at_bound'] for p in final.values())
     errors = [s['validation']['x_rms_counts'] for s in r['ladder']]
@@ -129,6 +138,22 @@ def test_other_rig_with_overruns_and_5ms_sampling_stays_plausible(data, tmp_path
                  str(tmp_path / 'loop'), '--json', '--no-plots']) == 0
     r = json.loads(capsys.readouterr().out)
     assert any('hanging' in n for n in r['data']['notes'])
+    # the loop moves the cart at 1-3 cm/s, below the Stribeck velocity (8 cm/s): the refit determines
+    # the friction at those speeds and the static level, not the law's parameters one by one; the report
+    # says so, prints the correlated pair, and the errors cover the truth
+    refit = r['ladder'][1]
+    fn = (rig['M'] + rig['m']) * rig['g']
+    fc, fs, eps, vs = rig['mu_c'] * fn, rig['mu_s'] * fn, rig['eps'], rig['v_s']
+    assert r['data']['moving_speeds_mps']['p95'] < vs
+    assert any('below the Stribeck velocity' in n for n in refit['notes'])
+    pair = next(c for c in refit['correlations'] if {c['a'], c['b']} == {'Fc', 'Fs_excess'})
+    assert abs(pair['r']) > 0.9 and pair['combination'] == pytest.approx(fs, abs=3 * pair['combination_std'])
+    for c in refit['friction_at_speeds']:
+        v = c['v']
+        truth = fc + (fs - fc) * math.exp(-(v / vs) ** 2) + eps * v
+        assert c['force'] == pytest.approx(truth, abs=3 * c['std']), c
+    p = {q['name']: q for q in refit['params']}
+    assert p['Fc']['value'] == pytest.approx(fc, abs=3 * p['Fc']['std'])
     assert 'sensor_bias' not in r['effects_added']
     assert not any(p['at_bound'] for p in r['ladder'][-1]['params'])
     dz = [t for t in r['effects_tried'] if t['effect'] == 'deadzone']

@@ -609,6 +609,13 @@ def cmd_identify(args) -> int:
             print(f'    {n}')
     last = r['ladder'][-1]
     print('  ' + ', '.join(f'{p["name"]} {_fmt_param(p)}' for p in last['params'] if p['fitted']))
+    from .ident.ladder_report import correlation_lines
+    for line in correlation_lines(last, {p['name']: p['unit'] for p in last['params']}):
+        print(f'  {line}')
+    rough = [p['name'] for p in last['params'] if p.get('rough')]
+    if rough:
+        print(f'  the simulated error is rough in {", ".join(rough)}: their errors come from a scan of the error '
+              f'along each')
     print(f'  report {Path(args.out) / "report.md"}')
     if args.export:
         print(f'  exported {r["export"]["scenario"]}' + (f' and {r["export"]["on_rig"]}' if args.rig else ''))

@@ -1,7 +1,7 @@
 """Identification from measured data: records and their loaders, the effect library, fitting,
 residual analysis, reports, experiments and the redesign loop.
 
-Modules: effects, equation_error, excitation, ladder, ladder_report, model, records,
+Modules: effects, equation_error, excitation, ladder, ladder_report, lsq, model, records,
 redesign, report, residual, shooting, uncertainty. Every public name below is loaded from its
 module on first use, so importing the package stays cheap."""
 from __future__ import annotations
@@ -25,6 +25,7 @@ _WHERE = {
     'Effect': 'effects',
     'FILTER_HZ': 'shooting',
     'FRICTION_FITTED': 'model',
+    'FULL_SHARE': 'ladder',
     'Fit': 'equation_error',
     'GRID_SCREENED': 'ladder',
     'LADDER_EFFECTS': 'model',
@@ -53,10 +54,13 @@ _WHERE = {
     'Prediction': 'shooting',
     'Prepared': 'equation_error',
     'Problem': 'ladder',
+    'REDO_GAIN': 'ladder',
     'REFIT_NOTE': 'ladder',
     'REST_SPAN': 'shooting',
     'Record': 'records',
     'SCREEN_GAIN': 'ladder',
+    'SCREEN_NFEV': 'ladder',
+    'SCREEN_SAMPLES': 'ladder',
     'SIGNATURES': 'residual',
     'SIM_GAIN_PERCENT': 'ladder',
     'SIZE': 'ladder',
@@ -98,6 +102,7 @@ _WHERE = {
     'effective_input': 'effects',
     'errors': 'equation_error',
     'eta_squared': 'residual',
+    'every': 'shooting',
     'explained': 'equation_error',
     'export_scenario': 'redesign',
     'figures': 'report',
@@ -107,6 +112,7 @@ _WHERE = {
     'fitted_plant_vector': 'equation_error',
     'friction_shift': 'uncertainty',
     'friction_summary': 'report',
+    'full_fit': 'ladder',
     'identified': 'ladder_report',
     'identify': 'equation_error',
     'identify_steady': 'equation_error',
@@ -144,6 +150,7 @@ _WHERE = {
     'run_ladder': 'ladder',
     'save_figure': 'report',
     'shifted': 'effects',
+    'short_fit': 'ladder',
     'signature_scores': 'residual',
     'smallest_moving_command': 'ladder',
     'smallest_step': 'records',
@@ -164,7 +171,7 @@ _WHERE = {
     'write_ladder_report': 'ladder_report',
     'write_report': 'report',
 }
-_MODULES = ['effects', 'equation_error', 'excitation', 'ladder', 'ladder_report', 'model', 'records',
+_MODULES = ['effects', 'equation_error', 'excitation', 'ladder', 'ladder_report', 'lsq', 'model', 'records',
             'redesign', 'report', 'residual', 'shooting', 'uncertainty']
 
 __all__ = sorted(_WHERE) + _MODULES

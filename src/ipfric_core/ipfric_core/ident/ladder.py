@@ -19,10 +19,20 @@ hypothesis. The ladder, on one metric (the multiple-shooting simulation error of
   lag at which the cart answers the command, a play of at least two encoder counts, a drive
   play that the motor side crosses at three reversals at least, in two samples or more.
 
+Each round, every candidate first gets a short fit (its own parameters and the friction
+levels, SCREEN_NFEV steps from each of its starts) on the cart's windows alone (the angle's
+too for an effect on the angle), on every k-th window where the estimation record holds more
+than SCREEN_SAMPLES samples per block (judged on every window: a short fit that does not carry
+over is done again on all); only the candidates whose short fit lowers the estimation error
+by at least FULL_SHARE of the best one's are fitted in full and judged (the others are
+listed with that reason and tried again next round).
+
 Fits are bounded least squares (``scipy.optimize.least_squares``) on parameters scaled to
-their typical size, with a finite-difference Jacobian; standard errors come from it,
-inflated for the correlation of the errors within a window (the effective sample count is
-the number of windows).
+their typical size, with finite-difference Jacobians (:mod:`ipfric_core.ident.lsq`; they end
+when a step gains less than ``lsq.FTOL``); standard errors come from the Jacobian at the end (in the
+scaled parameters), inflated for the correlation of the errors within a window (the effective
+sample count is the number of windows), and from a scan along a parameter where the error is
+rough in it or rises slower than a quadratic (:class:`Errors`, :func:`lsq.scan_errors`).
 """
 from __future__ import annotations
 
@@ -30,11 +40,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from ..physics.params import ConfigError
 from ..physics.rig import inputs_through
-from . import shooting
+from . import lsq, shooting
 from .effects import EFFECTS
 from .equation_error import BOOTSTRAP, P_VALUE
 from .model import LADDER_EFFECTS, Model
@@ -55,6 +64,12 @@ SCREEN_GAIN = 0.01       # an effect whose own parameters lower the estimation c
 #: effects started from a grid of their error: when its best point lowers the cart's estimation cost by
 #: less than SCREEN_GAIN, they are not fitted (a drive play's simulation costs tens of ordinary ones)
 GRID_SCREENED = ('drive_backlash',)
+#: the candidates' fits use windows spread over the estimation record, up to this many samples per
+#: block (a 2-minute record at 1 kHz: every second window); the kept effect is refitted on all
+SCREEN_SAMPLES = 30000
+SCREEN_NFEV = 12         # steps of a candidate's short fit
+FULL_SHARE = 0.5         # a candidate is fitted in full when its short fit gains this share of the best one's
+REDO_GAIN = 0.1          # a short fit that gains this much on a subset of windows and nothing on all is redone on all
 
 #: typical size of each parameter (the fit works on value / size)
 TYPICAL = {'M': 0.5, 'm': 0.1, 'l': 0.1, 'alpha': 1.0, 'beta': 5.0, 'Fc': 0.3, 'Fs_excess': 0.3, 'eps': 2.0,
@@ -66,23 +81,64 @@ TYPICAL = {'M': 0.5, 'm': 0.1, 'l': 0.1, 'alpha': 1.0, 'beta': 5.0, 'Fc': 0.3, '
 class Problem:
     """A record cut into windows, and the simulation error of a model on it: the cart's
     readings on :func:`shooting.cart_windows`, with a pendulum also its angle on
-    :func:`shooting.angle_windows` (weighted THETA_WEIGHT)."""
+    :func:`shooting.angle_windows` (weighted THETA_WEIGHT). The last few models' predictions
+    are kept (the ladder judges one model by several figures)."""
 
-    def __init__(self, rec: Record):
-        self.rec = rec
-        self.blocks = [('x', shooting.cart_windows(rec), 1.0)]
-        if rec.theta is not None:
-            self.blocks.append(('theta', shooting.angle_windows(rec), THETA_WEIGHT))
+    def __init__(self, rec: Record, blocks=None, subset: bool = False):
+        self.rec, self.subset = rec, subset     # subset: some of the record's windows (:meth:`screen`)
+        if blocks is None:
+            blocks = [('x', shooting.cart_windows(rec), 1.0)]
+            if rec.theta is not None:
+                blocks.append(('theta', shooting.angle_windows(rec), THETA_WEIGHT))
+        self.blocks = blocks
         n = len(self.blocks[0][1])
         if n < 3:
             raise ConfigError(f'{rec.name}: only {n} windows of valid samples; the record is too short or too '
                               f'broken by overruns (at least 3 are needed)')
         self.n_windows = sum(len(w) for _, w, _ in self.blocks)
         self.n_samples = int(sum(np.sum(w.stop - w.start) for _, w, _ in self.blocks))
+        self._kept: dict = {}
+        self._base: dict = {}
+
+    def screen(self, samples: int = SCREEN_SAMPLES) -> Problem:
+        """This problem on every k-th window of each block (k the smallest that keeps a block within
+        ``samples`` samples; itself when every block is that small): screens and the candidates' fits
+        run on it, the kept effect is refitted on every window."""
+        blocks = []
+        for key, win, wt in self.blocks:
+            k = max(1, math.ceil(float(np.sum(win.stop - win.start)) / samples))
+            blocks.append((key, shooting.every(win, k), wt))
+        if all(len(b[1]) == len(a[1]) for a, b in zip(self.blocks, blocks)):
+            return self
+        return Problem(self.rec, blocks, subset=True)
+
+    def cart(self) -> Problem:
+        """This problem on the cart's windows alone (the short fits of effects that do not act on the
+        angle: the cart's error is what they change; the angle's weighs THETA_WEIGHT^2 as much)."""
+        if len(self.blocks) == 1:
+            return self
+        if not hasattr(self, '_cart'):
+            self._cart = Problem(self.rec, self.blocks[:1], self.subset)
+        return self._cart
+
+    def baseline(self, model: Model, levels, prior: Model | None) -> Model:
+        """``model`` with only ``levels`` refitted here by a short fit (what a short fit of an effect must
+        beat on a subset of windows, where ``model`` was fitted on all); ``model`` itself on every window."""
+        if not self.subset or not levels:
+            return model
+        key = (model.vectors(), tuple(sorted(levels)))
+        if key not in self._base:
+            self._base[key] = fit_model(self, model, max_nfev=SCREEN_NFEV, only=levels, prior=prior, errors=False,
+                                        refresh=0)[0]
+        return self._base[key]
 
     def predictions(self, model: Model) -> list:
         vec = model.vectors()
-        return [shooting.predict(vec, self.rec, win) for _, win, _ in self.blocks]
+        if vec not in self._kept:
+            if len(self._kept) >= 4:
+                self._kept.pop(next(iter(self._kept)))
+            self._kept[vec] = [shooting.predict(vec, self.rec, win) for _, win, _ in self.blocks]
+        return self._kept[vec]
 
     def residuals(self, model: Model) -> np.ndarray:
         return np.concatenate([wt * shooting.reading_errors(p, self.rec, key)
@@ -95,7 +151,8 @@ class Problem:
     def cart_cost(self, model: Model) -> float:
         """Mean squared simulation error of the cart alone [counts^2] (one pass, for screening)."""
         key, win, _ = self.blocks[0]
-        pred = shooting.predict(model.vectors(), self.rec, win)
+        vec = model.vectors()
+        pred = self._kept[vec][0] if vec in self._kept else shooting.predict(vec, self.rec, win)
         return float(np.mean(shooting.reading_errors(pred, self.rec, key) ** 2))
 
     def summary(self, model: Model) -> dict:
@@ -109,16 +166,19 @@ class Problem:
                                for (key, win, wt), p in zip(self.blocks, self.predictions(model))])
 
 
-def fit_model(pr: Problem, model: Model, max_nfev: int = MAX_NFEV, only=None, prior: Model | None = None
-        ) -> tuple[Model, dict]:
+def fit_model(pr: Problem, model: Model, max_nfev: int = MAX_NFEV, only=None, prior: Model | None = None,
+              errors: bool = True, refresh: int | None = None, profile=None) -> tuple[Model, dict]:
     """Bounded least squares of the free parameters (or of those in ``only``); returns the
-    fitted model and the standard errors of the fitted parameters.
+    fitted model and the standard errors of the fitted parameters (:class:`Errors`; none without
+    ``errors``): the Jacobian's, checked along each parameter (of ``profile``, default all) for a
+    rough or flatter than quadratic sum of squares, and then from a scan along it.
 
     ``prior``: the declared model; each of its free values enters as a prior (standard
     deviation PRIOR_REL of its size; one standard deviation costs as much as PRIOR_COUNTS of
     RMS error on every compared sample), so that a direction the data hardly determine
     (Coulomb level against viscous slope at the low speeds of a limit cycle) stays at the
-    declared value instead of wandering to a bound."""
+    declared value instead of wandering to a bound. The Jacobian is differenced sparingly
+    (:func:`lsq.solve`)."""
     free = [p for p in model.free if only is None or p.name in only]
     if not free:
         return model, {}
@@ -132,21 +192,75 @@ def fit_model(pr: Problem, model: Model, max_nfev: int = MAX_NFEV, only=None, pr
     z0 = np.array([ref[names[i]] for i in anchored]) / scale[anchored] if anchored else np.zeros(0)
     sd = PRIOR_REL * np.maximum(np.abs(z0), np.array([TYPICAL.get(names[i], 1.0) for i in anchored]) / scale[anchored])
     weight = PRIOR_COUNTS * math.sqrt(pr.n_samples)
+    lin_jac = np.zeros((len(anchored), len(names)))
+    lin_jac[np.arange(len(anchored)), anchored] = weight / sd
 
-    def fun(z):
-        r = pr.residuals(model.with_values(dict(zip(names, z * scale))))
-        return np.concatenate([r, weight * (z[anchored] - z0) / sd]) if anchored else r
-    sol = least_squares(fun, x0, bounds=(lo, hi), diff_step=DIFF_STEP, max_nfev=max_nfev, method='trf')
+    def data(z):
+        return pr.residuals(model.with_values(dict(zip(names, z * scale))))
+
+    def lin(z):
+        return weight * (z[anchored] - z0) / sd
+    sol = lsq.solve(data, x0, lo, hi, max_nfev, DIFF_STEP, lin, lin_jac, lsq.REFRESH if refresh is None else refresh,
+                    final_jacobian=errors)
     fitted = model.with_values(dict(zip(names, sol.x * scale)))
+    if not errors:
+        return fitted, {}
     n = len(sol.fun)
-    inflation = n / max(1, pr.n_windows)      # errors within a window are correlated
+    # one standard deviation of the sum of squares: its residual variance, times the samples per window
+    # (the errors within a window are correlated: the windows count as the independent samples)
+    level = float(sol.fun @ sol.fun) / max(1, n - len(names)) * n / max(1, pr.n_windows)
     try:
-        J = sol.jac / scale
-        cov = np.linalg.pinv(J.T @ J) * float(sol.fun @ sol.fun) / max(1, n - len(names)) * inflation
-        std = np.sqrt(np.maximum(np.diag(cov), 0.0))
+        # in the scaled parameters (each about 1): in physical units the columns span ten decades (a
+        # contact stiffness of 1e5 N/m beside a play of 1e-3 m) and pinv dropped the stiffest as noise
+        cov = np.linalg.pinv(sol.jac.T @ sol.jac) * level
     except np.linalg.LinAlgError:
-        std = np.full(len(names), np.nan)
-    return fitted, dict(zip(names, map(float, std)))
+        return fitted, Errors(names, np.full((len(names), len(names)), np.nan))
+    se = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    # where the Jacobian's errors are not to be trusted: a rough error (forward and backward differences
+    # unlike), or one that does not rise as a quadratic would; there a scan along the parameter decides
+    cols = [i for i, nm in enumerate(names) if profile is None or nm in profile]
+    r0 = sol.fun[:len(sol.fun) - len(anchored)]
+    cosine = lsq.rough(sol.difference, sol.x, r0, np.full(len(names), 0.1 * DIFF_STEP), cols)
+    rough = [i for i in cols if cosine[i] < lsq.ROUGH_COSINE]
+    seen: dict = {}
+
+    def objective(z):
+        if z.tobytes() not in seen:
+            r, q = data(z), lin(z)
+            seen[z.tobytes()] = float(r @ r + q @ q)
+        return seen[z.tobytes()]
+    at = float(sol.fun @ sol.fun)
+    flat = lsq.quadratic(objective, sol.x, lo, hi, se, level, at, [i for i in cols if i not in rough])
+    wide, reach = lsq.scan_errors(objective, sol.x, lo, hi, se, level, at, sorted(rough + flat))
+    widen = np.where(se > 0, wide / np.where(se > 0, se, 1.0), 1.0)
+    cov = cov * np.outer(widen, widen) * np.outer(scale, scale)
+    return fitted, Errors(names, cov, {nm: r for nm, r in zip(names, reach) if r}, [names[i] for i in rough],
+                          [names[i] for i in flat])
+
+
+class Errors(dict):
+    """Standard errors of fitted parameters by name (a dict), with their covariance (``names``,
+    ``cov``, physical units), the parameters on which the simulated error is rough (``rough``) or rises
+    slower than a quadratic (``flat``: both with errors from :func:`lsq.scan_errors`, their
+    correlations stay the Jacobian's) and those whose scan stayed low up to a bound (``reach``: name
+    -> 'lo'/'hi'/'both'): the data do not confine them."""
+
+    def __init__(self, names, cov, reach=None, rough=(), flat=()):
+        super().__init__(zip(names, map(float, np.sqrt(np.maximum(np.diag(cov), 0.0)))))
+        self.names, self.cov, self.reach = list(names), np.asarray(cov, float), dict(reach or {})
+        self.rough, self.flat = list(rough), list(flat)
+
+    def correlations(self, threshold: float = 0.0) -> list[tuple[str, str, float]]:
+        """(a, b, r) of every pair whose correlation is at least ``threshold`` in size, largest first."""
+        sd = np.sqrt(np.maximum(np.diag(self.cov), 0.0))
+        out = []
+        for i in range(len(self.names)):
+            for j in range(i + 1, len(self.names)):
+                if sd[i] > 0 and sd[j] > 0:
+                    r = float(self.cov[i, j] / (sd[i] * sd[j]))
+                    if abs(r) >= threshold:
+                        out.append((self.names[i], self.names[j], r))
+        return sorted(out, key=lambda t: -abs(t[2]))
 
 
 def block_p_value(before: np.ndarray, after: np.ndarray) -> float:
@@ -334,26 +448,55 @@ def drive_starts(pr: Problem, model: Model, prior: Model, keep: int = 2) -> list
     return [grid[i] for i in np.argsort(costs)[:keep]]
 
 
-def candidate(pe: Problem, current: Model, name: str, prior: Model) -> tuple[Model, dict]:
-    """The best fit of ``current`` + ``name`` over its starts: a short fit of the effect's own
-    parameters with the friction levels (an effect the refit absorbed into them, a deadzone into
-    the Coulomb level, needs them free to show) from each start, then a full one from the best."""
+def short_fit(pe: Problem, current: Model, name: str, prior: Model, ps: Problem | None = None
+              ) -> tuple[Model, float]:
+    """The best short fit of ``current`` + ``name`` over its starts: the effect's own parameters with
+    the friction levels (an effect the refit absorbed into them, a deadzone into the Coulomb level,
+    needs them free to show), SCREEN_NFEV steps from each start, on the cart's windows of ``ps``
+    (:meth:`Problem.screen`, default ``pe``; the angle's too for an effect on the angle). Returns it
+    and the share by which it lowers the estimation error of every window of ``pe`` (0 for a grid
+    point that explains nothing: not fitted). Where the subset's fit does not carry over to every
+    window (it lowers the error by REDO_GAIN on the subset, by less than SCREEN_GAIN on all), the
+    fits are done again on ``pe``; on the subset, the gain is counted from the friction levels
+    refitted there alone (:meth:`Problem.baseline`), not from ``current``."""
+    ps = ps or pe
     own = {s.name for s in EFFECTS[name].params}
     levels = {p.name for p in current.free} & {'Fc', 'Fs_excess'}
     screen = (own - {'cog_period'}) | levels
-    starts = [current.with_effect(name, s).with_values(s) for s in effect_starts(pe, current, name, prior)]
+    starts = [current.with_effect(name, s).with_values(s) for s in effect_starts(ps, current, name, prior)]
     if name in GRID_SCREENED:
-        costs = [pe.cart_cost(m) for m in starts]
-        if min(costs) > (1 - SCREEN_GAIN) * pe.cart_cost(current):
-            return starts[int(np.argmin(costs))], {}   # the best of a grid explains nothing: not fitted
-    fits = [fit_model(pe, m, max_nfev=12, only=screen, prior=prior)[0] for m in starts]
-    costs = [pe.cost(m) for m in fits]
-    best = fits[int(np.argmin(costs))]
-    if min(costs) > (1 - SCREEN_GAIN) * pe.cost(current):
-        return best, {}   # explains nothing even with the levels free: not worth a full fit (and no
-        #                   standard error, so :func:`unresolved` refuses it)
+        costs = [ps.cart_cost(m) for m in starts]
+        if min(costs) > (1 - SCREEN_GAIN) * ps.cart_cost(current):
+            return starts[int(np.argmin(costs))], 0.0   # the best of a grid explains nothing: not fitted
+
+    def fit(pr):
+        pr = pr if EFFECTS[name].needs_theta else pr.cart()
+        fits = [fit_model(pr, m, max_nfev=SCREEN_NFEV, only=screen, prior=prior, errors=False, refresh=0)[0]
+                for m in starts]
+        best = fits[int(np.argmin([pr.cost(m) for m in fits]))]
+        return best, 1.0 - pr.cost(best) / pr.cost(pr.baseline(current, levels, prior))
+    best, gain = fit(ps)
+    full = 1.0 - pe.cost(best) / pe.cost(current)
+    if ps is not pe and gain >= REDO_GAIN and full < SCREEN_GAIN:
+        best, _ = fit(pe)
+        full = 1.0 - pe.cost(best) / pe.cost(current)
+    return best, full
+
+
+def full_fit(pe: Problem, current: Model, best: Model, name: str, prior: Model) -> tuple[Model, dict]:
+    """The fit of the effect's own parameters with the friction law's levels and slope from the short
+    fit ``best``, with standard errors."""
+    own = {s.name for s in EFFECTS[name].params}
     joint = own | ({p.name for p in current.free} & {'Fc', 'Fs_excess', 'eps'})
-    return fit_model(pe, best, only=joint, prior=prior)
+    return fit_model(pe, best, only=joint, prior=prior, profile=SIZE.get(name, ()))
+
+
+def candidate(pe: Problem, current: Model, name: str, prior: Model, ps: Problem | None = None
+              ) -> tuple[Model, dict]:
+    """:func:`short_fit`, then :func:`full_fit` when it lowers the estimation error by SCREEN_GAIN at least
+    (else the short fit, without standard errors: :func:`unresolved` refuses it)."""
+    best, gain = short_fit(pe, current, name, prior, ps)
+    return full_fit(pe, current, best, name, prior) if gain >= SCREEN_GAIN else (best, {})
 
 
 @dataclass
@@ -385,20 +528,31 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
     steps.append(Step('refit', refit, std, pe.summary(refit), pv.summary(refit), notes))
     say(f'refit: validation x error {steps[-1].val["x_rms_counts"]:.3g} counts')
     current, tried = refit, []
+    ps = pe.screen()
     for _ in range(MAX_ROUNDS):
         sse0_v = pv.window_sse(current)
         ranked = []
-        for name in LADDER_EFFECTS:
-            if name in current.effects or (allowed is not None and name not in allowed):
-                continue
-            if EFFECTS[name].needs_theta and est.theta is None:
-                continue
-            m, s = candidate(pe, current, name, declared)
+        names = [name for name in LADDER_EFFECTS if name not in current.effects
+                 and (allowed is None or name in allowed) and not (EFFECTS[name].needs_theta and est.theta is None)]
+        short = {name: short_fit(pe, current, name, declared, ps) for name in names}
+        top = max([gain for _, gain in short.values()], default=0.0)
+        for name in names:
+            m, screened = short[name]
+            s: dict = {}
+            behind = SCREEN_GAIN <= screened < FULL_SHARE * top
+            if screened >= SCREEN_GAIN and not behind:
+                m, s = full_fit(pe, current, m, name, declared)
             ev0, ev1 = pv.cost(current), pv.cost(m)
             ee0, ee1 = pe.cost(current), pe.cost(m)
             gain = 100 * (1 - math.sqrt(ev1 / ev0)) if ev0 > 0 else 0.0
             pval = block_p_value(sse0_v, pv.window_sse(m))
-            why = contradictions(pe, m, name) + unresolved(m, s, name)
+            why = contradictions(pe, m, name)
+            if behind:
+                why.append(f'its short fit lowers the estimation error by {100 * screened:.2g} %, less than '
+                           f'{100 * FULL_SHARE:g} % of the best one\'s {100 * top:.2g} %: not fitted in full '
+                           f'this round')
+            else:
+                why += unresolved(m, s, name)
             drop = math.sqrt(ev0) - math.sqrt(ev1)
             if gain <= SIM_GAIN_PERCENT:
                 why.append(f'validation error drops by {gain:.2f} % (needs > {SIM_GAIN_PERCENT:g} %)')

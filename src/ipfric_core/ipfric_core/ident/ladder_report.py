@@ -4,6 +4,7 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 
@@ -11,15 +12,75 @@ matplotlib.use('Agg')
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from ..physics.friction import friction_force  # noqa: E402
+from . import shooting  # noqa: E402
 from .ladder import TYPICAL, Problem, Step  # noqa: E402
 from .report import save_figure, write_report  # noqa: E402
 
+CORRELATED = 0.9     # pairs of fitted parameters correlated at least this much are reported
+CHI2_2D_95 = 5.991   # chi-square quantile of a 95 % joint region of two parameters
+
 
 def param_table(step: Step) -> list[dict]:
-    """Every parameter of a step: value, standard error (fitted ones), unit, fitted or known."""
+    """Every parameter of a step: value, standard error (fitted ones), unit, fitted or known, and
+    whether its error comes from a scan along it, the simulated error being rough in it (``rough``) or
+    flatter than a quadratic on a side (``flat``), and whether the scan stayed low up to a bound
+    (``unconfined``: 'lo', 'hi' or 'both')."""
+    rough, flat = getattr(step.std, 'rough', ()), getattr(step.std, 'flat', ())
+    reach = getattr(step.std, 'reach', {})
     return [{'name': p.name, 'value': p.value, 'std': step.std.get(p.name), 'unit': p.unit,
-             'fitted': p.free, 'at_bound': p.at_bound(1e-3 * TYPICAL.get(p.name, 1.0)), 'doc': p.doc}
+             'fitted': p.free, 'at_bound': p.at_bound(1e-3 * TYPICAL.get(p.name, 1.0)), 'doc': p.doc,
+             'rough': p.name in rough, 'flat': p.name in flat, 'unconfined': reach.get(p.name, '')}
             for p in step.model.params]
+
+
+def correlations(step: Step, threshold: float = CORRELATED) -> list[dict]:
+    """The pairs of fitted parameters of a step whose estimates are correlated at least ``threshold``:
+    the correlation, the combination a + w b the data determine best (w = -cov(a, b) / var(b), its
+    value and standard error; for the Coulomb level and the viscous slope, w is the speed [m/s] at
+    which the data fix the sliding friction) and the 95 % joint confidence region of the pair (an
+    ellipse; its extent along each parameter)."""
+    errors: Any = step.std
+    if not hasattr(errors, 'correlations'):
+        return []
+    index = {n: i for i, n in enumerate(errors.names)}
+    out = []
+    for a, b, r in errors.correlations(threshold):
+        i, j = index[a], index[b]
+        va, vb, cab = errors.cov[i, i], errors.cov[j, j], errors.cov[i, j]
+        w = -cab / vb
+        half_a, half_b = math.sqrt(CHI2_2D_95 * va), math.sqrt(CHI2_2D_95 * vb)
+        ma, mb = step.model[a], step.model[b]
+        out.append({'a': a, 'b': b, 'r': r, 'weight': w, 'combination': ma + w * mb,
+                    'combination_std': math.sqrt(max(va - cab ** 2 / vb, 0.0)),
+                    'region_95': {a: [ma - half_a, ma + half_a], b: [mb - half_b, mb + half_b]}})
+    return out
+
+
+def covariance(step: Step) -> dict | None:
+    """The covariance of the step's fitted parameters (physical units), or None."""
+    errors: Any = step.std
+    if not hasattr(errors, 'cov'):
+        return None
+    return {'names': list(errors.names), 'matrix': [[float(v) for v in row] for row in errors.cov]}
+
+
+def correlation_lines(s: dict, units: dict) -> list[str]:
+    """One sentence per correlated pair of a step of result.json (:func:`correlations`), and one with
+    the friction at the speeds the cart moved at (:func:`friction_curve`) when there are such pairs."""
+    lines = []
+    curve = s.get('friction_at_speeds') or []
+    if s.get('correlations') and curve:
+        lines.append('sliding friction at the speeds the cart moved at (5th, 50th, 95th percentile): ' + ', '.join(
+            f'{c["force"]:.4g} +/- {c["std"]:.2g} N at {c["v"]:.3g} m/s' for c in curve))
+    for c in s.get('correlations', []):
+        a, b = c['a'], c['b']
+        (a0, a1), (b0, b1) = c['region_95'][a], c['region_95'][b]
+        lines.append(f'{a} and {b} are correlated (r = {c["r"]:+.3f}): the data determine {a} '
+                     f'{c["weight"]:+.4g} {b} = {c["combination"]:.4g} +/- {c["combination_std"]:.2g} {units[a]}; '
+                     f'along it they trade (95 % joint region: {a} {a0:.4g} .. {a1:.4g} {units[a]}, '
+                     f'{b} {b0:.4g} .. {b1:.4g} {units[b]})')
+    return lines
 
 
 def identified(step: Step, dt: float) -> dict:
@@ -32,19 +93,73 @@ def identified(step: Step, dt: float) -> dict:
             'plant_truth': {k: v for k, v in m.plant_truth(dt).to_dict().items() if v and not k.startswith('noise')}}
 
 
+MOVING = 0.005       # a speed above this moves the cart [m/s] (the speeds reported: of those samples)
+
+
+def speeds(rec) -> dict:
+    """5th, 50th and 95th percentile of the cart's speed [m/s] over the samples where it moves."""
+    v = np.abs(shooting.rates(rec.t, rec.x, rec.valid_mask))
+    v = v[v > MOVING]
+    if len(v) == 0:
+        return {}
+    return {f'p{q}': float(np.quantile(v, q / 100)) for q in (5, 50, 95)}
+
+
+def friction_curve(step: Step, at: dict) -> list[dict]:
+    """The sliding friction [N] of the step's model (moving forward) at the speeds ``at`` (:func:`speeds`)
+    with its standard error from the covariance of the fitted parameters (first order): where the
+    cart never moves fast, these are what the data determine, not the law's parameters one by one."""
+    errors: Any = step.std
+    if not hasattr(errors, 'cov') or not at:
+        return []
+    names = [n for n in errors.names if n in ('Fc', 'Fs_excess', 'eps', 'v_s', 'asym', 'asym_v')]
+    if not names:
+        return []
+    index = [errors.names.index(n) for n in names]
+    cov = errors.cov[np.ix_(index, index)]
+
+    def force(model, v):
+        return -float(friction_force(model.vectors().fp, v, 0.0, 1.0))
+    out = []
+    for key, v in at.items():
+        f0 = force(step.model, v)
+        grad = []
+        for n in names:
+            h = 1e-6 * max(abs(step.model[n]), TYPICAL.get(n, 1.0))
+            grad.append((force(step.model.with_values({n: step.model[n] + h}), v) - f0) / h)
+        g = np.array(grad)
+        out.append({'speed': key, 'v': v, 'force': f0, 'std': float(math.sqrt(max(g @ cov @ g, 0.0)))})
+    return out
+
+
+def coverage_note(step: Step, at: dict) -> list[str]:
+    """Why the law's parameters are not separately determined where the cart never reaches its
+    Stribeck velocity (the speeds covered: :func:`speeds`)."""
+    if (not hasattr(step.std, 'cov') or 'v_s' not in step.std or not at
+            or at['p95'] >= step.model['v_s']):
+        return []
+    return [f'the cart moved at {at["p5"]:.3g} to {at["p95"]:.3g} m/s (5th to 95th percentile of the moving '
+            f'samples), below the Stribeck velocity v_s = {step.model["v_s"]:.3g} m/s: the data determine the '
+            f'friction at those speeds, not the Coulomb level beyond v_s nor the viscous slope apart']
+
+
 def ladder_result(res: dict) -> dict:
     est, val = res['estimation'], res['validation']
     steps = res['steps']
+    at = speeds(est)
     return {
         'data': {'estimation': est.name, 'validation': val.name, 'samples': [len(est.t), len(val.t)],
                  'sample_period_s': est.dt, 'pendulum': est.theta is not None,
                  'encoder_counts': {'x_m': est.x_resolution,
                                     'theta_rad': est.theta_resolution if est.theta is not None else None},
+                 'moving_speeds_mps': at,
                  'notes': list(dict.fromkeys(est.notes + val.notes))},
         'metric': 'simulation error by multiple shooting, in encoder counts (RMS) and in % of the motion '
                   'within the windows; estimation data fit, validation data judge',
         'ladder': [{'step': s.label, 'effects': list(s.model.effects), 'estimation': s.est, 'validation': s.val,
-                    'params': param_table(s), 'notes': s.notes} for s in steps],
+                    'params': param_table(s), 'correlations': correlations(s), 'covariance': covariance(s),
+                    'friction_at_speeds': friction_curve(s, at), 'notes': s.notes + coverage_note(s, at)}
+                   for s in steps],
         'effects_added': list(steps[-1].model.effects),
         'effects_tried': res['tried'],
         'identified': identified(steps[-1], est.dt),
@@ -75,9 +190,14 @@ def ladder_markdown(r: dict) -> str:
     for s in r['ladder']:
         lines += [f'### {s["step"]}', '', '| parameter | value | unit | fitted | |', '| --- | --- | --- | --- | --- |']
         for p in s['params']:
-            flag = 'on a bound' if p['at_bound'] else ''
+            flag = '; '.join(f for f in ('on a bound' if p['at_bound'] else '',
+                                         'rough: error from a scan' if p.get('rough') else '',
+                                         'flat profile: error from a scan' if p.get('flat') else '',
+                                         f'not confined ({p["unconfined"]})' if p.get('unconfined') else '') if f)
             lines.append(f'| {p["name"]} | {_fmt(p)} | {p["unit"]} | {"yes" if p["fitted"] else "known"} | {flag} |')
-        lines += [''] + [f'- {n}' for n in s['notes']] + ([''] if s['notes'] else [])
+        units = {p['name']: p['unit'] for p in s['params']}
+        notes = s['notes'] + correlation_lines(s, units)
+        lines += [''] + [f'- {n}' for n in notes] + ([''] if notes else [])
     lines += ['## Effects tried', '', '| effect | validation gain % | p | kept | why not |',
               '| --- | --- | --- | --- | --- |']
     for t in r['effects_tried']:

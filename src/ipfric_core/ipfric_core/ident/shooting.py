@@ -19,13 +19,13 @@ no window spans them.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numba
 import numpy as np
 from scipy.signal import butter, sosfiltfilt
 
-from ..physics import compiled  # noqa: F401  (sets numba's cache directory)
+from ..physics.compiled import compiled
 from ..physics.plant import motor_force, motor_side_free
 from ..physics.rig import input_effects, inputs_through, play
 from ..physics.simulate import advance, advance_drive
@@ -133,6 +133,14 @@ def make_windows(rec: Record, length_s: float, forced: bool = False, span: float
     return Windows(start, stop, state, held, angle, np.column_stack([speed, np.gradient(speed, t)]))
 
 
+def every(win: Windows, k: int) -> Windows:
+    """Every ``k``-th window of ``win`` (the first, the (k+1)-th, ...)."""
+    if k <= 1:
+        return win
+    pick = np.arange(0, len(win), k)
+    return replace(win, start=win.start[pick], stop=win.stop[pick], state=win.state[pick], held=win.held[pick])
+
+
 def cart_windows(rec: Record) -> Windows:
     """The windows on which the cart is judged: with a pendulum attached, its angle forced and
     the windows stretched up to REST_SPAN times to reach the next rest (a closed loop stops
@@ -146,7 +154,7 @@ def angle_windows(rec: Record) -> Windows:
     return make_windows(rec, PENDULUM_WINDOW_S, span=1.0)
 
 
-@numba.njit(cache=True)
+@compiled
 def drive_states(pp, gap, mass, t, u, motion):
     """(d, vb, side) of a drive with play at every sample ((d, vb) is the state of
     :func:`~ipfric_core.physics.simulate.advance_drive`; side +1 / -1 in contact pushing forward
@@ -177,7 +185,7 @@ def drive_states(pp, gap, mass, t, u, motion):
     return out
 
 
-@numba.njit(cache=True, parallel=True)   # the windows are independent: one thread each
+@compiled(parallel=True)   # the windows are independent: one thread each
 def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, drive0, t, u, start, stop, state, held,
            substep, forced, out):
     """Encoder readings (x, theta) predicted in every window, written into ``out`` (n, 2).
@@ -193,7 +201,10 @@ def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, drive0, t, 
         dr = (drive0[w, 0], drive0[w, 1])
         reading = s[0]
         k0 = start[w]
-        out[k0, 0], out[k0, 1] = reading, s[1] + theta_bias
+        if w == 0 or stop[w - 1] - 1 != k0:
+            # the start; where the window before ends on it, that sample is that window's last
+            # prediction (written by another thread: not overwritten here)
+            out[k0, 0], out[k0, 1] = reading, s[1] + theta_bias
         for k in range(k0, stop[w] - 1):
             v = input_effects(u[k], deadzone, saturation)
             if drive[0] > 0.0:
