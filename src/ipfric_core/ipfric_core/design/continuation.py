@@ -119,14 +119,17 @@ class _Window(OrbitError):
 
 @dataclass
 class _Point:
-    """A solved point: parameter p, its loop, the orbit, and the unit tangent (tu full state
-    length [state units], tq [range lengths]) along the branch."""
+    """A solved point: parameter p, its loop, the orbit, the unit tangent (tu full state
+    length [state units], tq [range lengths]) along the branch and the length of the step
+    that reached it (in the norm)."""
 
     p: float
     loop: LoopNumbers
     orbit: Orbit
     tu: np.ndarray
     tq: float
+    step: float = 0.0
+
 
 
 def _layout(loop: LoopNumbers) -> tuple[int, int]:
@@ -223,7 +226,7 @@ class _Tracer:
                     orbit = finish_orbit(here, u, level, crossings, c, J, w * scale, s, res, it)
                 return p, here, orbit
             if lu is None or res > 0.5 * res_prev:
-                if taken == refreshes:
+                if taken == refreshes or res > 4.0 * res_prev:     # diverging: a fresh Jacobian rarely helps
                     raise OrbitError(f'the corrector stalled at residual {res:.3g}')
                 J, col = self.derivatives(here, p, u, level, crossings, idx, scale, column=not fixed)
                 taken += 1
@@ -255,9 +258,9 @@ class _Tracer:
         k = _norm(null[:n], tq) * (1.0 if tq * direction >= 0 else -1.0)
         return tu / k, tq / k
 
-    def secant(self, a: _Point, p: float, loop, orbit) -> tuple[np.ndarray, float]:
-        """Unit tangent from point ``a`` to the new solved point, orthogonal to the loop's motion
-        (so that the section state does not drift along the orbit)."""
+    def secant(self, a: _Point, p: float, loop, orbit) -> _Point:
+        """The new solved point with its unit tangent from point ``a``, orthogonal to the loop's
+        motion (so that the section state does not drift along the orbit)."""
         u = orbit.state
         idx, scale = _scaled(loop, len(u))
         prev = resized(a.orbit.state, _layout(a.loop)[0], _layout(loop)[0])
@@ -268,23 +271,25 @@ class _Tracer:
         dq = (p - a.p) / self.span
         k = _norm(dv, dq)
         if not k > 0:
-            return a.tu, a.tq
+            return _Point(p, loop, orbit, a.tu, a.tq, 0.0)
         tu = np.zeros(len(u))
         tu[idx] = dv / k * scale
-        return tu, dq / k
+        return _Point(p, loop, orbit, tu, dq / k, k)
 
     # ------------------------------------------------------------------ a branch
     def follow(self, start: _Point, branch: int, direction: float) -> list[BranchPoint]:
         """Points from ``start`` (excluded) in ``direction`` of p until the branch ends.
 
         Steps are in p (the state predicted along the secant, p held by the corrector) while
-        that converges; next to a fold (a multiplier near +1) they switch to pseudo-arclength,
-        go round it, and switch back once the branch runs along p again."""
+        that converges. Where a step in p fails (a fold ahead: no orbit at that p), they switch
+        to pseudo-arclength at half the last step's length, go round the fold, and switch back
+        once the branch runs along p again (its tangent as steep in p as where they switched,
+        no real multiplier near +1)."""
         out: list[BranchPoint] = []
         events = self.result.events
         a, ds, dp = start, self.ds0, self.ds0 * self.span
         level, crossings = start.orbit.level, start.orbit.crossings
-        end, failures, arc = 'points', 0, False
+        end, failures, arc, tried, steep, reach = 'points', 0, False, False, 0.0, self.ds_max
         while len(out) < self.budget:
             self.floor = 0.5 * a.orbit.period / crossings
             if arc:
@@ -299,8 +304,9 @@ class _Tracer:
                 p_pred = min(max(p_pred, self.lo), self.hi)
             orbit = self.solve(a, p_pred, u_pred, level, crossings, fixed=last or not arc)
             if orbit is None:
-                if not arc and _near_one(a.orbit):
-                    arc, ds = True, self.ds0 / 4
+                if not arc and not tried and a.step > 0:
+                    arc, tried, steep, reach = True, True, abs(a.tq), max(a.step, self.ds_max)
+                    ds = max(0.5 * a.step, self.ds_min)
                     continue
                 failures += 1
                 ds, dp = 0.5 * ds, 0.5 * dp
@@ -308,17 +314,17 @@ class _Tracer:
                     end = 'lost'
                     break
                 continue
-            failures = 0
+            failures, tried = 0, False
             p, loop, orbit = orbit
-            tu, tq = self.secant(a, p, loop, orbit)
+            b = self.secant(a, p, loop, orbit)
             out.append(BranchPoint(p, branch, orbit))
-            if tq * a.tq < 0 and arc:
+            if b.tq * a.tq < 0 and arc:
                 events.append({'parameter': p, 'branch': branch, 'event': 'fold'})
                 direction = -direction
             if orbit.stable != a.orbit.stable:
                 events.append({'parameter': 0.5 * (p + a.p), 'branch': branch, 'event': 'stability',
                                'multiplier': _crossing_kind(orbit if not orbit.stable else a.orbit)})
-            a = _Point(p, loop, orbit, tu, tq)
+            a = b
             if orbit.x_p2p < DEAD:
                 end = 'dies'
                 break
@@ -328,10 +334,10 @@ class _Tracer:
             if last or not (self.lo + 1e-9 * self.span < p < self.hi - 1e-9 * self.span):
                 end = 'range'
                 break
-            if arc and not _near_one(orbit):
+            if arc and not _near_one(orbit) and abs(a.tq) >= steep:
                 arc = False                    # past the fold: steps in p again
             grow = 1.5 if orbit.iterations <= 4 else 1.0
-            ds, dp = min(self.ds_max, ds * grow), min(self.ds_max * self.span, dp * grow)
+            ds, dp = min(reach, ds * grow), min(self.ds_max * self.span, dp * grow)
         events.append({'parameter': a.p, 'branch': branch, 'event': end, 'x_p2p_m': a.orbit.x_p2p,
                        'max_multiplier_modulus': a.orbit.largest_multiplier})
         return out
