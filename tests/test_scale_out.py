@@ -50,6 +50,26 @@ def test_montecarlo_on_the_cluster_gives_the_local_rows(cluster, tmp_path):
     assert len({r['x_p2p_m'] for r in local}) > 10          # the draws differ, and so do the runs
 
 
+def test_continuation_on_the_cluster_gives_the_local_branches(cluster):
+    """The Jacobians' columns in tasks on the cluster: the same points, bit for bit."""
+    from ipfric_core.cli import _orbit_loop
+    from ipfric_core.design.continuation import trace
+    s = load_scenario(ROOT / 'config' / 'fig7_old_gain_exponential.yaml')
+    base = replace(s, sim=replace(s.sim, cart_resolution=0.0, angle_resolution=0.0))
+
+    def run(executor):
+        found = trace(lambda v: _orbit_loop(base, 'delay', v), 0.0, 0.004, 4, probes=1, partners=False,
+                      executor=executor)
+        return found.jacobians, [(p.parameter, p.branch, p.orbit.x_p2p, p.orbit.period, tuple(p.orbit.multipliers))
+                                 for p in found.points]
+    local = run(None)
+    with make_executor(cluster) as ex:
+        remote = run(ex)
+    assert remote == local
+    assert len(local[1]) >= 3 and local[0] >= 3
+    assert abs(local[1][0][2] - 0.014370) < 1e-5            # Figure 7's stick-slip cycle at delay 0 [m]
+
+
 def free_port() -> int:
     with socket.socket() as s:
         s.bind(('127.0.0.1', 0))
@@ -66,3 +86,8 @@ def test_unreachable_scheduler_is_a_clear_error(tmp_path, capsys):
     assert code == 2
     err = capsys.readouterr().err
     assert f'--scheduler {address}' in err and 'no Dask scheduler' in err
+    code = main(['orbit', '--config', str(ROOT / 'config' / 'fig7_old_gain_exponential.yaml'), '--simulate', '0',
+                 '--continue', 'delay=0:0.002:3', '--scheduler', address, '--no-plots',
+                 '--out', str(tmp_path / 'orbit')])
+    assert code == 2
+    assert f'--scheduler {address}' in capsys.readouterr().err

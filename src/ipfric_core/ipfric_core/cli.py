@@ -721,8 +721,12 @@ def cmd_orbit(args) -> int:
             print(f'[orbit] {name}: {text} ({time.perf_counter() - t0:.1f} s)', file=sys.stderr, flush=True)
 
         t0 = time.perf_counter()
-        found = trace(lambda v: _orbit_loop(base, name, v), start, stop, count,
-                      progress=None if args.json else progress)
+        from contextlib import nullcontext
+
+        from .executor import make_executor
+        with make_executor(args.scheduler) if args.scheduler else nullcontext() as cluster:
+            found = trace(lambda v: _orbit_loop(base, name, v), start, stop, count,
+                          progress=None if args.json else progress, executor=cluster)
         events = found.events
         res['continuation'] = {'parameter': name, 'range': [start, stop], 'points': len(found.points),
                                'branches': len({p.branch for p in found.points}), 'events': events,
@@ -942,6 +946,10 @@ def build_parser() -> argparse.ArgumentParser:
                    'of the range (default 100), e.g. delay=0:0.14')
     o.add_argument('--simulate', type=float, default=120.0,
                    help='also run the loop this many seconds and report its cycle beside the orbit (0 = no)')
+    o.add_argument('--scheduler', default=None, metavar='ADDRESS',
+                   help='with --continue: compute the Jacobians\' columns on the Dask cluster whose scheduler '
+                        'listens at ADDRESS (its workers run this project\'s environment); the same branches '
+                        'as on this machine\'s cores')
     o.add_argument('--describing', action='store_true',
                    help='with --continue over delay or gain: the describing-function prediction on the diagram')
     o.add_argument('--no-plots', action='store_true', help='numbers only')

@@ -150,8 +150,9 @@ class _Tracer:
     branch at most, first step ``ds0`` (in the norm above)."""
 
     def __init__(self, make_loop, lo: float, hi: float, budget: int, ds0: float, tol: float = 1e-9,
-                 growth: float = 4.0):
+                 growth: float = 4.0, executor=None):
         self.make_loop, self.lo, self.hi, self.budget, self.tol = make_loop, lo, hi, budget, tol
+        self.executor = executor
         self.span = max(hi - lo, 1e-12)
         self.ds0, self.ds_min, self.ds_max = ds0, ds0 / 64, growth * ds0
         self.result = Branches()
@@ -181,7 +182,8 @@ class _Tracer:
         base = return_map(loop, u, level, crossings, min_period=self.floor)
         if base.code != 'crossing':
             raise OrbitError(f'no return to the section ({base.code.replace("_", " ")})')
-        J = return_map_jacobian(loop, u, level, crossings, idx, scale, base.state[idx], min_period=self.floor)
+        J = return_map_jacobian(loop, u, level, crossings, idx, scale, base.state[idx], min_period=self.floor,
+                                executor=self.executor)
         self.result.jacobians += 1
         if not column:
             return J, np.zeros(len(idx))
@@ -368,7 +370,8 @@ class _Tracer:
             return None
         try:
             loop = self.loop_at(p_pred)
-            orbit = shoot(loop, resized(u_pred, held, _layout(loop)[0]), level, crossings, self.tol, 10, self.floor)
+            orbit = shoot(loop, resized(u_pred, held, _layout(loop)[0]), level, crossings, self.tol, 10, self.floor,
+                          self.executor)
             self.result.jacobians += orbit.iterations
         except OrbitError:
             return None
@@ -427,7 +430,7 @@ def _crossing_kind(unstable: Orbit) -> str:
 
 def trace(make_loop: Callable[[float], LoopNumbers], start: float, stop: float, points: int = 100,
           probes: int = 6, partners: bool = True, tol: float = 1e-7, growth: float = 4.0,
-          progress: Callable[[str], None] | None = None) -> Branches:
+          progress: Callable[[str], None] | None = None, executor=None) -> Branches:
     """Branches of orbits for the parameter in [start, stop].
 
     ``make_loop(p)`` gives the loop at parameter p. The first step is 1/(``points`` - 1) of the
@@ -436,10 +439,12 @@ def trace(make_loop: Callable[[float], LoopNumbers], start: float, stop: float, 
     with ``partners``, the unstable orbits found next to it), then from runs at ``probes``
     evenly spaced values whose cycles no traced branch holds. ``tol``: largest scaled residual
     of a point (1e-7: 0.1 um in a cart position). Steps grow up to ``growth`` times the first
-    where the corrector converges fast (1: every step the first one).
+    where the corrector converges fast (1: every step the first one). ``executor``: a
+    ``concurrent.futures`` executor (a Dask cluster's) on which the Jacobians' columns run, in
+    tasks (:func:`orbit.return_map_jacobian`); the branches are the same as without it.
     """
     lo, hi = min(start, stop), max(start, stop)
-    tr = _Tracer(make_loop, lo, hi, max(points, 2), 1.0 / (max(points, 2) - 1), tol, growth)
+    tr = _Tracer(make_loop, lo, hi, max(points, 2), 1.0 / (max(points, 2) - 1), tol, growth, executor)
     say = progress or (lambda text: None)
     grid = [lo + (hi - lo) * i / max(probes - 1, 1) for i in range(max(probes, 1))]
     for i, p in enumerate(grid):

@@ -49,6 +49,8 @@ from ..physics.friction import DYNAMIC, FP_MODEL
 
 #: what a cycle can end with
 CYCLE_CODES = ('crossing', 'no_crossing', 'fallen', 'track_limit')
+#: columns of the return map's Jacobian in one task on an executor
+COLUMNS_PER_TASK = 8
 #: entries of a cycle's summary (see :func:`_cycle`)
 OUT = ('samples', 'x_min', 'x_max', 'th_min', 'th_max', 'stuck', 'sticks', 'code')
 
@@ -289,9 +291,10 @@ def _residual(loop, z, level, crossings, idx, scale, w, s, min_period):
 
 
 def shoot(loop: LoopNumbers, z: np.ndarray, level: float, crossings: int = 1, tol: float = 1e-9,
-          max_iter: int = 25, min_period: float = 0.0) -> Orbit:
+          max_iter: int = 25, min_period: float = 0.0, executor=None) -> Orbit:
     """Newton's method on P^m(u) - u + s w = 0, w . (u - u0) = 0 from loop state ``z`` (at a
-    sample on the section of theta rising through ``level`` [rad])."""
+    sample on the section of theta rising through ``level`` [rad]); ``executor`` as
+    :func:`return_map_jacobian` takes it."""
     z = np.array(z, dtype=float)
     idx, scale = free_entries(loop, len(z)), entry_scale(loop, len(z))
     n = len(idx)
@@ -301,7 +304,8 @@ def shoot(loop: LoopNumbers, z: np.ndarray, level: float, crossings: int = 1, to
     for it in range(1, max_iter + 1):
         c, g = _residual(loop, z, level, crossings, idx, scale, w, s, min_period)
         res = float(np.max(np.abs(g)))
-        J = return_map_jacobian(loop, z, level, crossings, idx, scale, c.state[idx], min_period=min_period)
+        J = return_map_jacobian(loop, z, level, crossings, idx, scale, c.state[idx], min_period=min_period,
+                                executor=executor)
         if res < tol:
             return finish_orbit(loop, z, level, crossings, c, J, w, s, res, it)
         A = np.zeros((n + 1, n + 1))
@@ -326,13 +330,29 @@ def shoot(loop: LoopNumbers, z: np.ndarray, level: float, crossings: int = 1, to
     raise OrbitError(f'Newton did not converge in {max_iter} iterations (residual {res:.3g})')
 
 
-def return_map_jacobian(loop, z, level, crossings, idx, scale, base, max_period: float = 60.0, min_period: float = 0.0):
+def passes_apart(loop: LoopNumbers, z: np.ndarray, moved: np.ndarray, steps: np.ndarray, level: float,
+                 crossings: int, min_samples: int, max_samples: int) -> tuple[np.ndarray, np.ndarray]:
+    """(end states, codes) of ``crossings`` passes of the return map from ``z`` with entry
+    ``moved[j]`` moved by ``steps[j]``, for every j, on this process's cores."""
+    ends, codes = np.empty((len(moved), len(z))), np.empty(len(moved))
+    _cycles_apart(*loop.args(), z, moved, steps, level, crossings, min_samples, max_samples, ends, codes)
+    return ends, codes
+
+
+def return_map_jacobian(loop, z, level, crossings, idx, scale, base, max_period: float = 60.0, min_period: float = 0.0,
+                        executor=None):
     """Finite-difference D(P^m) on the free entries, in scaled units (forward differences, the
-    columns on every core)."""
+    columns on every core, or with ``executor`` (a ``concurrent.futures`` executor, e.g. a Dask
+    cluster's) in tasks of :data:`COLUMNS_PER_TASK` columns: the same numbers either way)."""
     steps = 1e-7 * np.maximum(np.abs(z[idx]), scale)
-    ends, codes = np.empty((len(idx), len(z))), np.empty(len(idx))
-    _cycles_apart(*loop.args(), z, idx, steps, level, crossings, int(min_period / loop.dt),
-                  int(max_period / loop.dt), ends, codes)
+    bounds = (level, crossings, int(min_period / loop.dt), int(max_period / loop.dt))
+    if executor is None:
+        ends, codes = passes_apart(loop, z, idx, steps, *bounds)
+    else:
+        tasks = [executor.submit(passes_apart, loop, z, idx[k:k + COLUMNS_PER_TASK], steps[k:k + COLUMNS_PER_TASK],
+                                 *bounds) for k in range(0, len(idx), COLUMNS_PER_TASK)]
+        parts = [t.result() for t in tasks]
+        ends, codes = np.vstack([e for e, _ in parts]), np.concatenate([c for _, c in parts])
     if np.any(codes != 0.0):
         bad = CYCLE_CODES[int(codes[np.flatnonzero(codes)[0]])]
         raise OrbitError(f'the return map is not defined next to this state ({bad.replace("_", " ")})')
