@@ -31,8 +31,10 @@ Undeclared effects (at most one per file):
     asymmetry  Fc, Fs times (1 + a) moving/breaking forward, (1 - a) backward
     delay      u(t) = V(t - d), d a whole number of samples                 [s]
     bias       the angle encoder reads th + b                               [rad]
-Sensors: readings are the true values rounded to encoder counts; the commanded
+Sensors: readings are the true values rounded to encoder counts (a count of 0, set by
+the spec's "rig_overrides" x_res / theta_res, reads the true value); the commanded
 voltage V is held over each sample (zero-order hold). CSV voltage is the command V.
+A spec may give "theta0" [rad], the initial pendulum angle of a closed loop (default THETA0).
 """
 
 import argparse
@@ -235,7 +237,7 @@ def _run(t, nsub, mode, sched, target, gain, frozen, p, ctrl, y0):
     mode 2: V = clip(K . (x_enc, th_enc, vx, vth), +-ctrl[5]), K = ctrl[0:4],
     with vx, vth the backward differences low-passed at ctrl[4] [Hz]; then hold the motor
     voltage u = deadzone(V delayed by ctrl[7] samples, ctrl[6]) until t[k+1].
-    ctrl[8] = angle bias [rad], ctrl[9], ctrl[10] = encoder counts [m], [rad].
+    ctrl[8] = angle bias [rad], ctrl[9], ctrl[10] = encoder counts [m], [rad] (0 = exact reading).
     """
     n = t.size
     xe, the, volt, um = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
@@ -249,8 +251,8 @@ def _run(t, nsub, mode, sched, target, gain, frozen, p, ctrl, y0):
         if frozen[k] and k > 0:
             xe[k], the[k] = xe[k - 1], the[k - 1]
         else:
-            xe[k] = rx * np.round(y[0] / rx) + 0.0          # + 0.0: no negative zeros
-            the[k] = rth * np.round((y[2] + ctrl[8]) / rth) + 0.0
+            xe[k] = rx * np.round(y[0] / rx) + 0.0 if rx > 0.0 else y[0]   # + 0.0: no negative zeros
+            the[k] = rth * np.round((y[2] + ctrl[8]) / rth) + 0.0 if rth > 0.0 else y[2] + ctrl[8]
         if k > 0:
             dt = t[k] - t[k - 1]
             a = 1.0 - math.exp(-2.0 * math.pi * ctrl[4] * dt)
@@ -438,7 +440,7 @@ def simulate(spec, duration=None, substep=SUBSTEP):
         size["delay_samples"] = delay_n
     ctrl = np.array([*K, FILTER_HZ, vlim, size.get("deadzone_V", 0.0), delay_n,
                      size.get("angle_bias_rad", 0.0), rig["x_res"], rig["theta_res"]])
-    y0 = np.array([0.0, 0.0, 0.0 if cart else THETA0, 0.0, 0.0, 0.0])
+    y0 = np.array([0.0, 0.0, 0.0 if cart else spec.get("theta0", THETA0), 0.0, 0.0, 0.0])
     nsub = np.maximum(1, np.ceil(np.diff(t) / substep - 1e-9)).astype(np.int64)
     xe, the, volt, um, xt, vt, tht = _run(t, nsub, mode, sched, target, gain, frozen, p, ctrl, y0)
     if np.abs(xt).max() > TRACK:
@@ -459,7 +461,9 @@ def simulate(spec, duration=None, substep=SUBSTEP):
         theta_note=None if cart else ("theta + pi wrapped to (-pi, pi] (pi = upright)"
                                       if spec["theta_ref"] == "hanging" else "0 = upright"),
         encoder=dict(x_count_m=rig["x_res"], theta_count_rad=rig["theta_res"],
-                     x_measures="cart", rounding="nearest count"),
+                     x_measures="cart",
+                     rounding="nearest count" if rig["x_res"] > 0 and rig["theta_res"] > 0
+                     else "nearest count (a count of 0: exact reading)"),
         initial_state=dict(x=0.0, theta=float(y0[2]), x_dot=0.0, theta_dot=0.0),
         voltage="command before deadzone/delay, zero-order hold", substep_s=substep,
         seed=spec["seed"], max_abs_x_true=float(np.abs(xt).max()),

@@ -190,7 +190,7 @@ class _Tracer:
         return J, self.column(loop, p, u, level, crossings, base.state[idx], idx, scale)
 
     def correct(self, p_pred: float, u_pred: np.ndarray, level: float, crossings: int, tu, tq: float,
-                fixed: bool = False, max_iter: int = 20, refreshes: int = 3):
+                fixed: bool = False, max_iter: int = 20, refreshes: int = 3, retake: bool = True):
         """Newton from the predicted point, the Jacobian kept while the residual falls fast and
         retaken (at most ``refreshes`` times) where it does not; returns (p, loop, orbit).
         ``fixed`` holds p at ``p_pred`` (a point on the range's bound) instead of the
@@ -228,7 +228,7 @@ class _Tracer:
                     orbit = finish_orbit(here, u, level, crossings, c, J, w * scale, s, res, it)
                 return p, here, orbit
             if lu is None or res > 0.5 * res_prev:
-                if taken == refreshes or res > 4.0 * res_prev:     # diverging: a fresh Jacobian rarely helps
+                if taken == refreshes or (res > 4.0 * res_prev and (taken > 1 or not retake)):   # diverging
                     raise OrbitError(f'the corrector stalled at residual {res:.3g}')
                 J, col = self.derivatives(here, p, u, level, crossings, idx, scale, column=not fixed)
                 taken += 1
@@ -304,7 +304,7 @@ class _Tracer:
             last = not (self.lo <= p_pred <= self.hi)
             if last:
                 p_pred = min(max(p_pred, self.lo), self.hi)
-            orbit = self.solve(a, p_pred, u_pred, level, crossings, fixed=last or not arc)
+            orbit = self.solve(a, p_pred, u_pred, level, crossings, fixed=last or not arc, retake=failures == 0)
             if orbit is None:
                 if not arc and not tried and a.step > 0:
                     arc, tried, steep, reach = True, True, abs(a.tq), max(a.step, self.ds_max)
@@ -345,7 +345,7 @@ class _Tracer:
         return out
 
     def solve(self, a: _Point, p_pred: float, u_pred: np.ndarray, level: float, crossings: int,
-              fixed: bool):
+              fixed: bool, retake: bool = True):
         """(p, loop, orbit) from the predicted point, or None: the corrector, then (at a kink
         of the branch) damped Newton at the predicted p."""
         tu, held = a.tu, _layout(a.loop)[0]
@@ -361,7 +361,7 @@ class _Tracer:
                             break
                         u_pred = c.state
                 try:
-                    return self.correct(p_pred, u_pred, level, crossings, tu, a.tq, fixed=fixed)
+                    return self.correct(p_pred, u_pred, level, crossings, tu, a.tq, fixed=fixed, retake=retake)
                 except _Window as jump:
                     p_pred, u_pred = jump.p, jump.u
         except OrbitError:
