@@ -128,8 +128,7 @@ class Problem:
             return model
         key = (model.vectors(), tuple(sorted(levels)))
         if key not in self._base:
-            self._base[key] = fit_model(self, model, max_nfev=SCREEN_NFEV, only=levels, prior=prior, errors=False,
-                                        refresh=0)[0]
+            self._base[key] = fit_model(self, model, max_nfev=SCREEN_NFEV, only=levels, prior=prior, errors=False)[0]
         return self._base[key]
 
     def predictions(self, model: Model) -> list:
@@ -167,7 +166,7 @@ class Problem:
 
 
 def fit_model(pr: Problem, model: Model, max_nfev: int = MAX_NFEV, only=None, prior: Model | None = None,
-              errors: bool = True, refresh: int | None = None, profile=None) -> tuple[Model, dict]:
+              errors: bool = True, profile=None) -> tuple[Model, dict]:
     """Bounded least squares of the free parameters (or of those in ``only``); returns the
     fitted model and the standard errors of the fitted parameters (:class:`Errors`; none without
     ``errors``): the Jacobian's, checked along each parameter (of ``profile``, default all) for a
@@ -200,7 +199,7 @@ def fit_model(pr: Problem, model: Model, max_nfev: int = MAX_NFEV, only=None, pr
 
     def lin(z):
         return weight * (z[anchored] - z0) / sd
-    sol = lsq.solve(data, x0, lo, hi, max_nfev, DIFF_STEP, lin, lin_jac, lsq.REFRESH if refresh is None else refresh,
+    sol = lsq.solve(data, x0, lo, hi, max_nfev, DIFF_STEP, lin, lin_jac,
                     final_jacobian=errors)
     fitted = model.with_values(dict(zip(names, sol.x * scale)))
     if not errors:
@@ -471,7 +470,7 @@ def short_fit(pe: Problem, current: Model, name: str, prior: Model, ps: Problem 
 
     def fit(pr):
         pr = pr if EFFECTS[name].needs_theta else pr.cart()
-        fits = [fit_model(pr, m, max_nfev=SCREEN_NFEV, only=screen, prior=prior, errors=False, refresh=0)[0]
+        fits = [fit_model(pr, m, max_nfev=SCREEN_NFEV, only=screen, prior=prior, errors=False)[0]
                 for m in starts]
         best = fits[int(np.argmin([pr.cost(m) for m in fits]))]
         return best, 1.0 - pr.cost(best) / pr.cost(pr.baseline(current, levels, prior))

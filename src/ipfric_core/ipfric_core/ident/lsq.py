@@ -7,14 +7,9 @@ crossed in many short steps. :func:`solve` drives ``scipy.optimize.least_squares
 linear in the parameters, the priors, come with their exact Jacobian) and ends a fit when a
 step lowers the sum of squares by less than FTOL of it (a limit cycle's valley of Coulomb
 level against viscous slope is flat to 1e-4: the fits crawled along it for hundreds of
-simulations).
-
-With ``refresh`` > 0 the Jacobian is differenced afresh only every ``refresh`` accepted steps
-and updated in between by Broyden's rank-one secant from the steps taken (both ends are
-simulated anyway), afresh at once after a step that gained less than a quarter of what it
-promised or 1 % of the sum of squares, at the first FRESH_FIRST steps, and before the fit may
-stop. It is off (REFRESH = 0): on a ripple it lost precision (0.84 counts left on the
-independent cart_cogging file against 0.69) and saved no time once the fits stop at FTOL.
+simulations). The Jacobian is differenced afresh at every step: Broyden secant updates in
+between lost precision on a ripple (0.84 counts left on the independent cart_cogging file
+against 0.69) and saved no time once the fits stop at FTOL.
 
 After a fit, :func:`rough`, :func:`quadratic` and :func:`scan_errors` check its standard errors
 along each parameter.
@@ -26,11 +21,6 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-REFRESH = 0          # accepted steps between fresh finite differences (0: every step; secant updates lost
-                     # precision on a ripple: 0.84 counts left on cart_cogging against 0.69, in the same time)
-GOOD_RATIO = 0.25    # a step that gains less than this share of the promised drop refreshes the Jacobian
-SLOW = 0.01          # and so does a step that lowers the sum of squares by less than this share
-FRESH_FIRST = 3      # the first steps of a fit (far from its optimum) always take fresh differences
 FTOL = 1e-4          # a fit ends at a step that lowers the sum of squares by less than this share of it
 
 
@@ -44,20 +34,17 @@ class Solution:
     difference: object = None   # (x, data rows, step) -> forward differences of the data rows
 
 
-class _Secant:
-    """Residual and Jacobian callables for least_squares (see the module docstring)."""
+class _Differences:
+    """Residual and Jacobian callables for least_squares: the costly rows cached by x, their
+    Jacobian by forward differences, the linear rows exact."""
 
-    def __init__(self, data, lin_rows, lin_jac, lo, hi, step, refresh):
+    def __init__(self, data, lin_rows, lin_jac, lo, hi, step):
         self.data, self.lin_rows, self.lin_jac = data, lin_rows, lin_jac
-        self.lo, self.hi, self.step, self.refresh = lo, hi, step, refresh
+        self.lo, self.hi, self.step = lo, hi, step
         self.cache: dict = {}
         self.evaluations = 0
         self.J = None           # Jacobian of the data rows
-        self.at = None          # (x, data rows) where J was last set
-        self.age = 0            # secant updates since the last fresh difference
-        self.trials: list = []  # (x, data rows) evaluated since the last Jacobian
-        self.force = False
-        self.jacobians = 0      # Jacobians handed out
+        self.at = None          # x where J was last set
 
     def rows(self, x):
         key = x.tobytes()
@@ -69,9 +56,7 @@ class _Secant:
         return self.cache[key]
 
     def fun(self, x):
-        r = self.rows(x)
-        self.trials.append((x.copy(), r))
-        return np.concatenate([r, self.lin_rows(x)])
+        return np.concatenate([self.rows(x), self.lin_rows(x)])
 
     def difference(self, x, r0, step=None, cols=None):
         """Forward differences, each step ``step`` (default the fit's) relative to max(1, |x|), turned back
@@ -90,31 +75,11 @@ class _Secant:
         return J
 
     def jac(self, x):
-        r = self.rows(x)
-        self.jacobians += 1
-        fresh = self.force or self.J is None or self.age >= self.refresh or self.jacobians <= FRESH_FIRST
-        if not fresh:
-            x0, r0 = self.at
-            dx = x - x0
-            f0, f = np.concatenate([r0, self.lin_rows(x0)]), np.concatenate([r, self.lin_rows(x)])
-            model = f0 + np.vstack([self.J, self.lin_jac]) @ dx
-            promised, gained = f0 @ f0 - model @ model, f0 @ f0 - f @ f
-            fresh = (not (promised > 0.0 and gained >= GOOD_RATIO * promised and gained >= SLOW * (f0 @ f0))
-                     or not np.any(dx) or np.any((x - self.lo) * (self.hi - x) <= 1e-12 * (self.hi - self.lo) ** 2))
-        if fresh:
-            self.J, self.age = self.difference(x, r), 0
-        else:
-            # the rejected trials since the last Jacobian, then the step taken: secants from x0
-            for xt, rt in [t for t in self.trials if not np.array_equal(t[0], x)] + [(x, r)]:
-                dt = xt - x0
-                if np.any(dt):
-                    self.J = self.J + np.outer((rt - r0) - self.J @ dt, dt) / (dt @ dt)
-            self.age += 1
-        self.at, self.trials, self.force = (x.copy(), r), [], False
+        self.J, self.at = self.difference(x, self.rows(x)), x.copy()
         return np.vstack([self.J, self.lin_jac])
 
 
-def solve(data, x0, lo, hi, max_nfev: int, step, lin_rows=None, lin_jac=None, refresh: int = REFRESH,
+def solve(data, x0, lo, hi, max_nfev: int, step, lin_rows=None, lin_jac=None,
           final_jacobian: bool = True) -> Solution:
     """Minimise |data(x)|^2 + |lin_rows(x)|^2 over lo <= x <= hi.
 
@@ -127,19 +92,17 @@ def solve(data, x0, lo, hi, max_nfev: int, step, lin_rows=None, lin_jac=None, re
     if lin_rows is None:
         lin_rows, lin_jac = (lambda x: np.zeros(0)), np.zeros((0, n))
     step = np.broadcast_to(np.asarray(step, float), (n,))
-    s = _Secant(data, lin_rows, lin_jac, lo, hi, step, refresh)
+    s = _Differences(data, lin_rows, lin_jac, lo, hi, step)
     x, budget, status = np.asarray(x0, float), max_nfev, 0
     while budget > 0:
-        s.force, s.trials = True, []
         sol = least_squares(s.fun, x, jac=s.jac, bounds=(lo, hi), max_nfev=budget, method='trf', ftol=FTOL)
         budget -= sol.nfev
         x, status = sol.x, sol.status
-        settled = s.age == 0 and np.array_equal(s.at[0], x)
-        if status <= 0 or settled:
+        if status <= 0 or np.array_equal(s.at, x):
             break        # the budget is spent, or it stopped on a fresh Jacobian
     r = s.rows(x)
-    if final_jacobian and not (s.age == 0 and np.array_equal(s.at[0], x)):
-        s.J, s.age, s.at = s.difference(x, r), 0, (x.copy(), r)
+    if final_jacobian and not np.array_equal(s.at, x):
+        s.J, s.at = s.difference(x, r), x.copy()
     jac = np.vstack([s.J, lin_jac]) if s.J is not None else np.vstack([s.difference(x, r), lin_jac])
     return Solution(x, np.concatenate([r, lin_rows(x)]), jac, s.evaluations, status, s.difference)
 
