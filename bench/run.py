@@ -302,7 +302,38 @@ def bench_orbit(quick: bool) -> list[dict]:
                  'reference': f'{runs} runs of 20 s {t_runs:.3g} s',
                  'ipfric': f'{t_branch:.3g} s ({len(found.points)} orbits, {found.jacobians} Jacobians)',
                  'ratio': t_runs / t_branch, 'target': '< 30 s', 'met': t_branch < 30.0})
+    rows.append(bench_basin())
     return rows
+
+
+def bench_basin() -> dict:
+    """The unstable orbit on the edge of the upright's basin (gain (23), exponential friction with
+    tanh(100 v), delay 90 ms, exact sensors) beside the bisection of theta0 by `sweep --threshold`:
+    the starts of the orbit's shape scaled by f settle below f* and fall above; f* against 1."""
+    from ipfric_core.analysis.sweep import threshold_angle
+    from ipfric_core.cli import _orbit_loop
+    from ipfric_core.design.basin import basin_edge, shape_threshold
+    base = exact(load_scenario(CONFIG / 'fig9_new_gain_exponential.yaml'))
+    base = replace(base, friction=base.friction.replace(smoothing='tanh'))
+    base = scenario_at(base, 'delay', 0.09)
+    t_bisect, sweep = timed(lambda: threshold_angle(base, math.radians(0.05), math.radians(0.1), 40.0))
+
+    def edge_and_shape():
+        edge = basin_edge(lambda a: _orbit_loop(base, 'theta0', a), 1e-4, 0.03)
+        return edge, shape_threshold(_orbit_loop(base, 'theta0', edge.settles_below), edge.orbit)
+    t_edge, (edge, (f_lo, f_hi)) = timed(edge_and_shape)
+    o = edge.orbit
+    off = max(abs(f_lo - 1), abs(f_hi - 1))
+    inside = sweep['settles_below_rad'] <= edge.settles_below <= sweep['oscillates_from_rad']
+    return {'benchmark': 'unstable orbit on the edge of the upright\'s basin (gain (23), tanh, delay 90 ms)',
+            'reference': f'sweep --threshold {t_bisect:.3g} s: theta0 {sweep["settles_below_rad"]:.5g}-'
+                         f'{sweep["oscillates_from_rad"]:.5g} rad ({sweep["runs"]} runs of 40 s)',
+            'ipfric': f'{t_edge:.3g} s: x p2p {1e3 * o.x_p2p:.4g} mm, multiplier {o.largest_multiplier:.3g}; '
+                      f'starts of its shape settle to {f_lo:.5f} and fall from {f_hi:.5f} times its size; '
+                      f'theta0 threshold {edge.settles_below:.6g} rad '
+                      f'({edge.settles_below / (0.5 * o.theta_p2p):.3f} of its angle amplitude)',
+            'ratio': t_bisect / t_edge, 'target': 'orbit size within 5 % of the bisection threshold',
+            'met': off < 0.05 and inside}
 
 
 # ------------------------------------------------------------------------------------ table

@@ -668,14 +668,44 @@ def cmd_bench(args) -> int:
     return 0
 
 
-def _orbit_loop(base, name: str, value: float):
-    """The sampled loop of scenario ``base`` at continuation parameter ``name`` = ``value`` (a
-    delay may fall between samples here)."""
+def _orbit_loop(base, name: str, value: float, delay: float | None = None):
+    """The sampled loop of scenario ``base`` at parameter ``name`` = ``value`` (a continuation
+    parameter or theta0 [rad]), with the feedback delay ``delay`` [s] (default the scenario's)
+    unless the parameter is the delay; a delay may fall between samples here."""
+    from dataclasses import replace
+
     from .analysis.sweep import scenario_at
     from .design.orbit import loop_numbers
-    scn = base if name == 'delay' else scenario_at(base, name, value)
+    scn = base if name in ('delay', 'theta0') else scenario_at(base, name, value)
+    if name == 'theta0':
+        scn = replace(base, sim=replace(base.sim, theta0=value))
     return loop_numbers(scn.make_rig().loop_spec(), scn.make_controller().loop_spec(),
-                        value if name == 'delay' else None)
+                        value if name == 'delay' else base.controller.delay if delay is None else delay)
+
+
+def _basin(args, base, delay: float) -> dict:
+    """--basin LO,HI: the edge of the upright's basin over theta0 and the orbit on it."""
+    from .design.basin import basin_edge, shape_threshold
+    try:
+        lo, hi = (float(v) for v in args.basin.split(','))
+    except ValueError:
+        raise ConfigError(f'--basin: {args.basin!r}: expected LO,HI in rad, e.g. 1e-4,0.05') from None
+    if not (math.isfinite(lo) and math.isfinite(hi) and 0 <= lo < hi):
+        raise ConfigError(f'--basin: need finite 0 <= LO < HI [rad], got {args.basin!r}')
+    if not (math.isfinite(args.duration) and args.duration > 0):
+        raise ConfigError(f'--duration: {args.duration!r} must be a positive number of seconds')
+
+    def loop_at(theta0):
+        return _orbit_loop(base, 'theta0', theta0, delay)
+    try:
+        edge = basin_edge(loop_at, lo, hi, duration=args.duration)
+    except ValueError as exc:
+        raise ConfigError(f'--basin: {exc}') from None
+    out = edge.summary()
+    if edge.orbit is not None:
+        out['shape_threshold'] = list(shape_threshold(loop_at(edge.settles_below), edge.orbit,
+                                                      duration=args.duration))
+    return out
 
 
 def cmd_orbit(args) -> int:
@@ -693,6 +723,12 @@ def cmd_orbit(args) -> int:
                               '(delay [s]; gain and friction as multiples of the scenario\'s)')
         if cont[0] == 'delay' and min(cont[1:3]) < 0:
             raise ConfigError('--continue delay: delays must be >= 0 s')
+    delay = base.controller.delay
+    if args.delay is not None:
+        if not (math.isfinite(args.delay) and args.delay >= 0):
+            raise ConfigError(f'--delay: {args.delay!r} must be finite and >= 0 s')
+        from .analysis.sweep import scenario_at
+        delay, base = args.delay, scenario_at(base, 'delay', args.delay)   # runs: whole samples
     import time
 
     from .design.continuation import trace, unstable_partners
@@ -700,20 +736,23 @@ def cmd_orbit(args) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    loop = _orbit_loop(base, 'delay', base.controller.delay)
+    loop = _orbit_loop(base, 'delay', delay, delay)
     try:
         main_orbit = find_orbit(loop)
         orbits = [main_orbit] + unstable_partners(loop, main_orbit)
     except OrbitError as exc:
         orbits, why = [], str(exc)
     took = time.perf_counter() - t0
-    res: dict = {'config': args.config, 'sensors': args.sensors, 'delay_s': base.controller.delay,
+    res: dict = {'config': args.config, 'sensors': args.sensors, 'delay_s': delay,
                  'orbits': [o.summary() for o in orbits], 'seconds': round(took, 3)}
     if not orbits:
         res['no_orbit'] = why
+    if args.basin:
+        res['basin'] = _basin(args, base, delay)
     if args.simulate > 0:
         from .design.orbit import simulated_cycle
         res['simulation'] = simulated_cycle(base.make_rig(), base.make_controller(), args.simulate)
+        res['simulation']['delay_s'] = base.controller.delay
     if cont:
         name, start, stop, count = cont
 
@@ -725,7 +764,7 @@ def cmd_orbit(args) -> int:
 
         from .executor import make_executor
         with make_executor(args.scheduler) if args.scheduler else nullcontext() as cluster:
-            found = trace(lambda v: _orbit_loop(base, name, v), start, stop, count,
+            found = trace(lambda v: _orbit_loop(base, name, v, delay), start, stop, count,
                           progress=None if args.json else progress, executor=cluster)
         events = found.events
         res['continuation'] = {'parameter': name, 'range': [start, stop], 'points': len(found.points),
@@ -755,8 +794,7 @@ def cmd_orbit(args) -> int:
     if args.json:
         _print_json(res)
         return 0
-    print(f'Periodic orbits of {args.config} ({args.sensors} sensors, delay {base.controller.delay:g} s), '
-          f'{took:.2f} s')
+    print(f'Periodic orbits of {args.config} ({args.sensors} sensors, delay {delay:g} s), {took:.2f} s')
     if not orbits:
         print(f'  none: {why}')
     for o in orbits:
@@ -764,10 +802,25 @@ def cmd_orbit(args) -> int:
         print(f'  {"stable  " if o.stable else "unstable"} x p2p {100 * o.x_p2p:.4f} cm, theta p2p '
               f'{o.theta_p2p:.3e} rad, period {o.period:.5f} s, stuck {100 * o.stuck_fraction:.1f} % '
               f'({o.sticks} sticking phases), largest multiplier |{m:.3g}|')
+    if 'basin' in res:
+        b = res['basin']
+        print(f'  basin of the upright: runs from theta0 <= {b["settles_below_rad"]:.6g} rad settle, from '
+              f'{b["leaves_from_rad"]:.6g} rad they leave ({b["runs"]} runs of up to {args.duration:g} s)')
+        if b['orbit']:
+            o = b['orbit']
+            f_lo, f_hi = b['shape_threshold']
+            print(f'    the run at the edge lingers on the unstable orbit x p2p {100 * o["x_p2p_m"]:.4f} cm, theta '
+                  f'p2p {o["theta_p2p_rad"]:.4e} rad, period {o["period_s"]:.5f} s, largest multiplier '
+                  f'|{o["max_multiplier_modulus"]:.3g}|; the threshold is {b["threshold_over_orbit_amplitude"]:.3f} '
+                  f'of its angle amplitude')
+            print(f'    starts of its shape settle up to {f_lo:.5f} and leave from {f_hi:.5f} times its size: '
+                  f'it bounds the basin')
+        else:
+            print(f'    no periodic orbit at the edge: {b["no_orbit"]}')
     if 'simulation' in res:
         s = res['simulation']
-        print(f'  simulation ({args.simulate:g} s, last half): x p2p {100 * s["x_p2p_m"]:.4f} cm, '
-              f'period {s["period_s"]:.5f} s ({s["end_reason"]})')
+        print(f'  simulation ({args.simulate:g} s, delay {s["delay_s"]:g} s, last half): x p2p '
+              f'{100 * s["x_p2p_m"]:.4f} cm, period {s["period_s"]:.5f} s ({s["end_reason"]})')
     if cont:
         c = res['continuation']
         print(f'  continuation in {c["parameter"]} over {c["range"][0]:g}:{c["range"][1]:g}: {c["points"]} orbits on '
@@ -944,6 +997,14 @@ def build_parser() -> argparse.ArgumentParser:
                    help='trace the branches of orbits over delay [s], gain or friction (multiples of the '
                    'scenario\'s gain, or of its mu_s, mu_c and eps) by continuation, first step 1/(POINTS-1) '
                    'of the range (default 100), e.g. delay=0:0.14')
+    o.add_argument('--delay', type=float, default=None,
+                   help='feedback delay [s] instead of the scenario\'s; it may fall between samples (the '
+                   '--simulate run takes it to whole samples)')
+    o.add_argument('--basin', metavar='LO,HI',
+                   help='also find the edge of the upright\'s basin over the initial angle in [LO, HI] rad '
+                   '(bisection: LO must settle, HI leave) and the unstable orbit the run at the edge lingers on')
+    o.add_argument('--duration', type=float, default=40.0,
+                   help='with --basin: longest run [s] (default %(default)s)')
     o.add_argument('--simulate', type=float, default=120.0,
                    help='also run the loop this many seconds and report its cycle beside the orbit (0 = no)')
     o.add_argument('--scheduler', default=None, metavar='ADDRESS',

@@ -1,8 +1,9 @@
 """Design on the physics (paper sections 3-5): linearization, LQR, Routh-Hurwitz, the critical
-delay, the describing-function prediction of the hunting, periodic orbits, friction estimates from
-the appendix tables, the printed numbers, and the design check of a gain.
+delay, the describing-function prediction of the hunting, periodic orbits, the edge of the
+upright's basin, friction estimates from the appendix tables, the printed numbers, and the
+design check of a gain.
 
-Modules: check, continuation, critical_delay, describing, estimation, linearize, lqr, orbit, paper, paperconfig,
+Modules: basin, check, continuation, critical_delay, describing, estimation, linearize, lqr, orbit, paper, paperconfig,
 reports, stability.
 Every public name below is loaded from its module on first use, so importing the package
 stays cheap."""
@@ -26,6 +27,7 @@ _WHERE = {
     'DELAY_STEP': 'check',
     'DELAY_TOL': 'check',
     'DELTA_COMPLEX_UNTIL': 'paper',
+    'Edge': 'basin',
     'DELTA_UNSTABLE_ABOVE': 'paper',
     'Design': 'lqr',
     'EIG_DYNAMIC_GAIN_15': 'paper',
@@ -76,10 +78,12 @@ _WHERE = {
     'design_check': 'check',
     'design_report': 'reports',
     'entry_scale': 'orbit',
+    'fate': 'basin',
     'find_orbit': 'orbit',
     'free_entries': 'orbit',
     'finish_orbit': 'orbit',
     'return_map_jacobian': 'orbit',
+    'basin_edge': 'basin',
     'friction_estimates': 'reports',
     'friction_loop': 'describing',
     'friction_to_state': 'describing',
@@ -105,6 +109,7 @@ _WHERE = {
     'sensitivity': 'check',
     'settle': 'orbit',
     'settled_cycle': 'check',
+    'shape_threshold': 'basin',
     'shoot': 'orbit',
     'shrunk': 'orbit',
     'simulated_cycle': 'orbit',
@@ -116,7 +121,7 @@ _WHERE = {
     'unstable_partners': 'continuation',
     'verdict': 'check',
 }
-_MODULES = ['check', 'continuation', 'critical_delay', 'describing', 'estimation', 'linearize', 'lqr', 'orbit',
+_MODULES = ['basin', 'check', 'continuation', 'critical_delay', 'describing', 'estimation', 'linearize', 'lqr', 'orbit',
             'paper', 'paperconfig', 'reports', 'stability']
 
 __all__ = sorted(_WHERE) + _MODULES
