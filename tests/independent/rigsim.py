@@ -21,6 +21,9 @@ removed, when m = 0 in the dynamics), Fc = mu_c F_N, Fs = mu_s F_N:
 Integration: fixed-step RK4 (default 0.1 ms) with sgn(v) frozen inside each step;
 a zero crossing of v is located by regula falsi (Illinois), v is set to 0 there
 and the stick condition tested.
+Smoothed friction (spec "smoothing": {"delta": d}, d [s/m]): sgn(v) becomes tanh(d v),
+    F_fric = -(Fc + (Fs - Fc) exp(-(v / v_s)^2)) tanh(d v) - eps v,
+the law is smooth and there is no sticking: plain RK4 steps, no stop located, no stick test.
 
 Undeclared effects (at most one per file):
     deadzone   u = 0 if |V| <= dz else V - sgn(V) dz                       [V]
@@ -35,6 +38,17 @@ Sensors: readings are the true values rounded to encoder counts (a count of 0, s
 the spec's "rig_overrides" x_res / theta_res, reads the true value); the commanded
 voltage V is held over each sample (zero-order hold). CSV voltage is the command V.
 A spec may give "theta0" [rad], the initial pendulum angle of a closed loop (default THETA0).
+Closed-loop spec keys (absent: as above):
+    "K"                       the gain, V = K . (x, th, x', th') (default K_PAPER / LQR)
+    "feedback_delay_samples"  n: the command at sample k uses the row r_(k-n) of readings and
+                              filtered velocities (x_enc, th_enc, vx, vth) taken at sample k - n,
+                              and (x_enc_0, th_enc_0, 0, 0), the first reading at rest, for k < n;
+                              the filter itself runs every sample on the current readings. (The
+                              "delay" effect instead delays the voltage and holds 0 V meanwhile.)
+    "stop_when_fallen"        true: the run ends at the first sample with |th| > FALLEN or |x| >
+                              TRACK (true state) and returns the samples so far, truth "end" =
+                              "fallen" / "track" / "duration"; false (default): the whole run,
+                              an error if the cart left the track.
 """
 
 import argparse
@@ -55,6 +69,7 @@ THETA_RES = 2 * math.pi / 4096    # angle encoder count [rad] (0.08789 deg)
 FILTER_HZ = 20.0                  # low-pass corner of the velocity estimates [Hz]
 VMAX = 10.0                       # controller voltage limit [V]
 THETA0 = math.radians(2.0)        # initial pendulum angle of the closed loops [rad]
+FALLEN = 0.5236                   # |theta| beyond which the pendulum has fallen [rad] (30 deg)
 K_PAPER = (70.7107, 142.5409, 50.6911, 26.9817)   # gain (15): V = K . (x, th, x', th')
 Q_LQR = (5000.0, 3000.0, 20.0, 20.0)               # paper's LQR state weight, r = 1
 
@@ -104,9 +119,9 @@ CASES = {
     "cart_jitter": _case("quanser", "cart", seed=41, timing="jitter"),
 }
 
-# Layout of the plant parameter vector p.
+# Layout of the plant parameter vector p (_DELTA: tanh smoothing of sgn(v) [s/m], 0 = none).
 (_M, _MP, _L, _G, _AL, _BE, _FC, _FS, _EPS, _VS, _ASYM,
- _CA, _CP, _CPH, _GAP, _MB, _KB, _CB) = range(18)
+ _CA, _CP, _CPH, _GAP, _MB, _KB, _CB, _DELTA) = range(19)
 
 
 # ----------------------------------------------------------------------------- plant
@@ -135,10 +150,15 @@ def _net(y, u, p):
 
 @_jit
 def _deriv(y, u, sgn, stuck, p, dy):
-    """State derivative, y = (x, x', th, th', xb, xb'); sgn = frozen sign of x' when sliding."""
+    """State derivative, y = (x, x', th, th', xb, xb'); sgn = frozen sign of x' when sliding
+    (with smoothing, p[_DELTA] > 0, tanh(delta x') is used instead)."""
     m, c = p[_MP], math.cos(y[2])
     acc = 0.0
-    if not stuck:
+    if p[_DELTA] > 0.0:
+        fric = (-(p[_FC] + (p[_FS] - p[_FC]) * math.exp(-(y[1] / p[_VS]) ** 2)) * math.tanh(p[_DELTA] * y[1])
+                - p[_EPS] * y[1])
+        acc = (_net(y, u, p) + fric) / (p[_M] + m - 0.75 * m * c * c)
+    elif not stuck:
         lev = 1.0 + p[_ASYM] * sgn
         fric = (-lev * (p[_FC] + (p[_FS] - p[_FC]) * math.exp(-(y[1] / p[_VS]) ** 2)) * sgn
                 - p[_EPS] * y[1])
@@ -206,7 +226,10 @@ def _to_rest(y, rem, u, sgn, p, w):
 
 @_jit
 def _substep(y, h, u, st, p, w):
-    """Advance y by h [s]; st = (stuck flag, sign of sliding) is updated."""
+    """Advance y by h [s]; st = (stuck flag, sign of sliding) is updated (not used with smoothing)."""
+    if p[_DELTA] > 0.0:
+        _rk4(y, h, u, 0, False, p, w, y)
+        return
     rem = h
     for _ in range(8):
         if st[0] == 1:
@@ -234,18 +257,24 @@ def _run(t, nsub, mode, sched, target, gain, frozen, p, ctrl, y0):
     """Sampled experiment. Per sample k (time t[k] [s]): read the encoders, compute the command
 
     mode 0: V = sched;  mode 1: V = clip(sched + gain (target - x_enc), +-ctrl[5]);
-    mode 2: V = clip(K . (x_enc, th_enc, vx, vth), +-ctrl[5]), K = ctrl[0:4],
-    with vx, vth the backward differences low-passed at ctrl[4] [Hz]; then hold the motor
+    mode 2: V = clip(K . (x_enc, th_enc, vx, vth)_(k - ctrl[11]), +-ctrl[5]), K = ctrl[0:4],
+    with vx, vth the backward differences low-passed at ctrl[4] [Hz] (the row of sample
+    j = k - ctrl[11], or (x_enc, th_enc, 0, 0) of sample 0 while j < 0); then hold the motor
     voltage u = deadzone(V delayed by ctrl[7] samples, ctrl[6]) until t[k+1].
     ctrl[8] = angle bias [rad], ctrl[9], ctrl[10] = encoder counts [m], [rad] (0 = exact reading).
+    ctrl[12] > 0: stop at the first sample with |th| > ctrl[12] [rad] (end code 1) or |x| >
+    ctrl[13] [m] (end code 2), true state, after recording it. Returns the arrays and (samples
+    recorded, end code 0 = whole run).
     """
     n = t.size
     xe, the, volt, um = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
     xt, vt, tht = np.zeros(n), np.zeros(n), np.zeros(n)
+    vxs, vths = np.zeros(n), np.zeros(n)
     y = y0.copy()
     st = np.array([1, 1])
     w = np.zeros((7, 6))
     vlim, dz, dn, rx, rth = ctrl[5], ctrl[6], int(ctrl[7]), ctrl[9], ctrl[10]
+    fn, fall, track = int(ctrl[11]), ctrl[12], ctrl[13]
     vx = vth = 0.0
     for k in range(n):
         if frozen[k] and k > 0:
@@ -258,21 +287,27 @@ def _run(t, nsub, mode, sched, target, gain, frozen, p, ctrl, y0):
             a = 1.0 - math.exp(-2.0 * math.pi * ctrl[4] * dt)
             vx += a * ((xe[k] - xe[k - 1]) / dt - vx)
             vth += a * ((the[k] - the[k - 1]) / dt - vth)
+        vxs[k], vths[k] = vx, vth
         if mode[k] == 0:
             v = sched[k]
         elif mode[k] == 1:
             v = sched[k] + gain[k] * (target[k] - xe[k])
-        else:
-            v = ctrl[0] * xe[k] + ctrl[1] * the[k] + ctrl[2] * vx + ctrl[3] * vth
+        elif k >= fn:
+            j = k - fn
+            v = ctrl[0] * xe[j] + ctrl[1] * the[j] + ctrl[2] * vxs[j] + ctrl[3] * vths[j]
+        else:                      # the first reading at rest: (x_enc_0, th_enc_0, 0, 0)
+            v = ctrl[0] * xe[0] + ctrl[1] * the[0]
         volt[k] = (v if mode[k] == 0 else min(max(v, -vlim), vlim)) + 0.0
         ud = volt[k - dn] if k >= dn else 0.0
         um[k] = 0.0 if abs(ud) <= dz else ud - math.copysign(dz, ud)
         xt[k], vt[k], tht[k] = y[0], y[1], y[2]
+        if fall > 0.0 and (abs(y[2]) > fall or abs(y[0]) > track):
+            return xe, the, volt, um, xt, vt, tht, k + 1, 1 if abs(y[2]) > fall else 2
         if k + 1 < n:
             h = (t[k + 1] - t[k]) / nsub[k]
             for _ in range(nsub[k]):
                 _substep(y, h, um[k], st, p, w)
-    return xe, the, volt, um, xt, vt, tht
+    return xe, the, volt, um, xt, vt, tht, n, 0
 
 
 # ------------------------------------------------------------------------- design
@@ -407,7 +442,19 @@ def simulate(spec, duration=None, substep=SUBSTEP):
     Fc, Fs = rig["mu_c"] * FN, rig["mu_s"] * FN
     effect = spec["effect"]
     size = dict(EFFECTS[effect], **spec.get("size", {}))
-    p = np.zeros(18)
+    loop_keys = {"K", "feedback_delay_samples", "stop_when_fallen"} & set(spec)
+    if cart and loop_keys:
+        raise ValueError(f"closed-loop keys in a cart experiment: {sorted(loop_keys)}")
+    smoothing = spec.get("smoothing")
+    if smoothing is not None and not smoothing["delta"] > 0.0:
+        raise ValueError(f"smoothing delta = {smoothing['delta']!r}: must be > 0 [s/m]")
+    if smoothing is not None and effect == "asymmetry":
+        raise ValueError("smoothing and the asymmetry effect together are not defined")
+    fb_n = int(spec.get("feedback_delay_samples", 0))
+    if fb_n != spec.get("feedback_delay_samples", 0) or fb_n < 0:
+        raise ValueError(f"feedback_delay_samples = {spec['feedback_delay_samples']!r}: a whole number >= 0")
+    stop = bool(spec.get("stop_when_fallen", False))
+    p = np.zeros(19)
     p[[_M, _MP, _L, _G, _AL, _BE, _FC, _FS, _EPS, _VS]] = (
         rig["M"], m, rig["l"], rig["g"], rig["alpha"], rig["beta"], Fc, Fs, rig["eps"], rig["v_s"])
     p[_CP] = 1.0
@@ -418,6 +465,8 @@ def simulate(spec, duration=None, substep=SUBSTEP):
     elif effect == "backlash":
         p[[_GAP, _MB, _KB, _CB]] = (size["gap_m"], size["motor_mass_kg"], size["k_N_per_m"],
                                     size["c_N_s_per_m"])
+    if smoothing is not None:
+        p[_DELTA] = smoothing["delta"]
     K = np.zeros(4)
     truth = {}
     if cart:
@@ -427,23 +476,36 @@ def simulate(spec, duration=None, substep=SUBSTEP):
                              for k, s, d, q in plan if s < t[-1]]
         vlim = 4.0
     else:
-        K = np.array(K_PAPER) if spec["rig"] == "quanser" else lqr_gain(rig)
+        if "K" in spec:
+            K = np.array(spec["K"], dtype=float)
+            if K.shape != (4,) or not np.isfinite(K).all():
+                raise ValueError(f"K = {spec['K']!r}: 4 finite gains (x, th, x', th')")
+        else:
+            K = np.array(K_PAPER) if spec["rig"] == "quanser" else lqr_gain(rig)
         mode = np.full(t.size, 2, dtype=np.int64)
         sched, target, gain = np.zeros(t.size), np.zeros(t.size), np.zeros(t.size)
         truth["controller"] = dict(
             law="V = K . (x, theta_up, x', theta_up') from encoder readings, clipped",
             K=K.tolist(), velocity_filter=f"backward difference, first-order low-pass {FILTER_HZ} Hz",
             voltage_limit_V=VMAX, excitation=None)
+        if "feedback_delay_samples" in spec:
+            truth["controller"].update(
+                feedback_delay_samples=fb_n,
+                feedback_delay_note="V_k from the row (x_enc, th_enc, vx, vth) of sample k - n; "
+                                    "(x_enc_0, th_enc_0, 0, 0) for k < n")
         vlim = VMAX
     delay_n = int(round(size.get("delay_s", 0.0) / Ts))
     if effect == "delay":
         size["delay_samples"] = delay_n
     ctrl = np.array([*K, FILTER_HZ, vlim, size.get("deadzone_V", 0.0), delay_n,
-                     size.get("angle_bias_rad", 0.0), rig["x_res"], rig["theta_res"]])
+                     size.get("angle_bias_rad", 0.0), rig["x_res"], rig["theta_res"], fb_n,
+                     FALLEN if stop else 0.0, TRACK])
     y0 = np.array([0.0, 0.0, 0.0 if cart else spec.get("theta0", THETA0), 0.0, 0.0, 0.0])
     nsub = np.maximum(1, np.ceil(np.diff(t) / substep - 1e-9)).astype(np.int64)
-    xe, the, volt, um, xt, vt, tht = _run(t, nsub, mode, sched, target, gain, frozen, p, ctrl, y0)
-    if np.abs(xt).max() > TRACK:
+    *arrays, rows, end = _run(t, nsub, mode, sched, target, gain, frozen, p, ctrl, y0)
+    t = t[:rows]
+    xe, the, volt, um, xt, vt, tht = (a[:rows] for a in arrays)
+    if not stop and np.abs(xt).max() > TRACK:
         raise RuntimeError(f"cart left the track: max |x| = {np.abs(xt).max():.3f} m")
     theta = None
     if not cart:
@@ -452,9 +514,10 @@ def simulate(spec, duration=None, substep=SUBSTEP):
         effect=effect, effect_size=size, rig=spec["rig"], experiment=spec["experiment"],
         pendulum_attached=not cart,
         constants={k: rig[k] for k in ("M", "m", "l", "g", "alpha", "beta")},
-        friction=dict(model="exponential (Stribeck), true stick-slip", mu_s=rig["mu_s"],
-                      mu_c=rig["mu_c"], eps=rig["eps"], v_s=rig["v_s"], gamma=2.0,
-                      F_N=FN, Fc=Fc, Fs=Fs),
+        friction=dict(model="exponential (Stribeck), true stick-slip" if smoothing is None
+                      else "exponential (Stribeck), sgn(v) smoothed to tanh(delta v), no sticking",
+                      mu_s=rig["mu_s"], mu_c=rig["mu_c"], eps=rig["eps"], v_s=rig["v_s"], gamma=2.0,
+                      F_N=FN, Fc=Fc, Fs=Fs, **({} if smoothing is None else {"delta": p[_DELTA]})),
         sample_period_s=Ts, timing=timing, rows=int(t.size), duration_s=float(t[-1]),
         columns=["t", "x", "voltage"] + ([] if cart else ["theta"]),
         theta_reference=spec["theta_ref"],
@@ -468,6 +531,8 @@ def simulate(spec, duration=None, substep=SUBSTEP):
         voltage="command before deadzone/delay, zero-order hold", substep_s=substep,
         seed=spec["seed"], max_abs_x_true=float(np.abs(xt).max()),
         max_abs_theta_true=None if cart else float(np.abs(tht).max()))
+    if stop:
+        truth["end"] = ("duration", "fallen", "track")[end]
     return dict(t=t, x=xe, voltage=volt, theta=theta, truth=truth,
                 state=dict(x=xt, v=vt, theta=tht, u=um))
 

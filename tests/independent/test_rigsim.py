@@ -243,3 +243,45 @@ def test_cli_writes_csv_and_manifest(tmp_path):
     assert manifest["loop_none"]["controller"]["K"] == list(rs.K_PAPER)
     rows = np.loadtxt(tmp_path / "loop_none.csv", delimiter=",", skiprows=1)
     assert rows.shape == (3001, 4) and rows[-1, 0] == pytest.approx(3.0)
+
+
+def test_feedback_delay_uses_the_row_n_samples_back():
+    """V_k = clip(K . r_(k-n)), r_j = (x, th, vx, vth) of sample j; (x_0, th_0, 0, 0) for k < n."""
+    n, Ts = 25, QUANSER["Ts"]
+    spec = dict(rs.CASES["loop_none"], rig_overrides=dict(x_res=0.0, theta_res=0.0), theta0=0.01)
+    data = rs.simulate(dict(spec, feedback_delay_samples=n), 3.0)
+    assert data["truth"]["controller"]["feedback_delay_samples"] == n
+    x, th, K = data["x"], data["theta"], np.array(rs.K_PAPER)
+    e = math.exp(-2 * math.pi * rs.FILTER_HZ * Ts)
+    rate = np.zeros((x.size, 2))
+    for k in range(1, x.size):
+        raw = (np.array([x[k], th[k]]) - [x[k - 1], th[k - 1]]) / Ts
+        rate[k] = e * rate[k - 1] + (1 - e) * raw
+    rows = np.column_stack([x, th, rate])
+    rows = np.vstack([np.tile([x[0], th[0], 0.0, 0.0], (n, 1)), rows[:-n]])
+    np.testing.assert_allclose(data["voltage"], np.clip(rows @ K, -rs.VMAX, rs.VMAX), rtol=1e-9, atol=1e-12)
+    v = data["voltage"]
+    assert np.all(v[:n + 1] == v[0]) and v[n + 1] != v[0]      # row 0 is the reading at rest too
+    plain, zero = rs.simulate(spec, 3.0), rs.simulate(dict(spec, feedback_delay_samples=0), 3.0)
+    for key in ("x", "theta", "voltage"):
+        assert np.array_equal(plain[key], zero[key])
+
+
+def test_smoothing_replaces_sticking_by_creep():
+    """tanh(delta v) for sgn(v): no rest (x' = 0) once moving, the same speed when sliding fast."""
+    spec = rs.CASES["cart_none"]
+    sticky, smooth = generate("cart_none"), rs.simulate(dict(spec, smoothing={"delta": 100.0}))
+    assert "tanh" in smooth["truth"]["friction"]["model"]
+    assert np.count_nonzero(sticky["state"]["v"] == 0.0) > 10000
+    assert np.count_nonzero(smooth["state"]["v"][1:] == 0.0) == 0
+    for seg in _segments(smooth, "step"):
+        if abs(seg["V"]) == 3.0:      # tanh(100 v) = 1 to 1e-30 at this speed
+            assert _steady_speed(smooth, seg) == pytest.approx(_steady_speed(sticky, seg), rel=1e-3)
+
+
+def test_gain_override_and_stop_when_fallen():
+    spec = dict(rs.CASES["loop_none"], K=[-k for k in rs.K_PAPER], stop_when_fallen=True)
+    data = rs.simulate(spec, 10.0)
+    assert data["truth"]["controller"]["K"] == [-k for k in rs.K_PAPER]
+    assert data["truth"]["end"] == "fallen" and data["t"].size < 2000
+    assert abs(data["state"]["theta"][-1]) > rs.FALLEN >= np.abs(data["state"]["theta"][:-1]).max()

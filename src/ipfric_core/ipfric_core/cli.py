@@ -683,8 +683,8 @@ def _orbit_loop(base, name: str, value: float, delay: float | None = None):
                         value if name == 'delay' else base.controller.delay if delay is None else delay)
 
 
-def _basin(args, base, delay: float) -> dict:
-    """--basin LO,HI: the edge of the upright's basin over theta0 and the orbit on it."""
+def _basin(args, base, delay: float):
+    """--basin LO,HI: the edge of the upright's basin over theta0 and the orbit on it (summary, Edge)."""
     from .design.basin import basin_edge, shape_threshold
     try:
         lo, hi = (float(v) for v in args.basin.split(','))
@@ -705,7 +705,7 @@ def _basin(args, base, delay: float) -> dict:
     if edge.orbit is not None:
         out['shape_threshold'] = list(shape_threshold(loop_at(edge.settles_below), edge.orbit,
                                                       duration=args.duration))
-    return out
+    return out, edge
 
 
 def cmd_orbit(args) -> int:
@@ -747,8 +747,9 @@ def cmd_orbit(args) -> int:
                  'orbits': [o.summary() for o in orbits], 'seconds': round(took, 3)}
     if not orbits:
         res['no_orbit'] = why
+    edge = None
     if args.basin:
-        res['basin'] = _basin(args, base, delay)
+        res['basin'], edge = _basin(args, base, delay)
     if args.simulate > 0:
         from .design.orbit import simulated_cycle
         res['simulation'] = simulated_cycle(base.make_rig(), base.make_controller(), args.simulate)
@@ -764,8 +765,9 @@ def cmd_orbit(args) -> int:
 
         from .executor import make_executor
         with make_executor(args.scheduler) if args.scheduler else nullcontext() as cluster:
+            given = [(delay if name == 'delay' else 1.0, edge.orbit)] if edge and edge.orbit else []
             found = trace(lambda v: _orbit_loop(base, name, v, delay), start, stop, count,
-                          progress=None if args.json else progress, executor=cluster)
+                          progress=None if args.json else progress, executor=cluster, orbits=given)
         events = found.events
         res['continuation'] = {'parameter': name, 'range': [start, stop], 'points': len(found.points),
                                'branches': len({p.branch for p in found.points}), 'events': events,
@@ -1002,7 +1004,8 @@ def build_parser() -> argparse.ArgumentParser:
                    '--simulate run takes it to whole samples)')
     o.add_argument('--basin', metavar='LO,HI',
                    help='also find the edge of the upright\'s basin over the initial angle in [LO, HI] rad '
-                   '(bisection: LO must settle, HI leave) and the unstable orbit the run at the edge lingers on')
+                   '(bisection: LO must settle, HI leave) and the unstable orbit the run at the edge lingers on; '
+                   'with --continue its branch is traced too')
     o.add_argument('--duration', type=float, default=40.0,
                    help='with --basin: longest run [s] (default %(default)s)')
     o.add_argument('--simulate', type=float, default=120.0,

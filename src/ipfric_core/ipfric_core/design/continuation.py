@@ -16,7 +16,8 @@ predictor and tangent are carried over by :func:`orbit.resized`.
 
 Events: ``fold`` (dp/ds changes sign), ``stability`` (the largest multiplier crosses the unit
 circle: at +1, -1 or as a complex pair), and how a branch ends: ``range`` (the parameter
-left the range), ``dies`` (the orbit shrinks to rest), ``joins`` (it runs onto another
+left the range), ``dies`` (the orbit shrinks to rest; where the corrector stops short of it,
+at the parameter its squared amplitude extrapolates to 0, as at a Hopf point), ``joins`` (it runs onto another
 branch), ``lost`` (the corrector fails at the smallest step), ``points`` (the point budget).
 Besides the branch of the orbit the loop runs into at the range's start (and the unstable
 orbits next to it), runs from the scenario's start at a few probe values pick up branches
@@ -25,7 +26,7 @@ the others do not reach.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -292,6 +293,7 @@ class _Tracer:
         a, ds, dp = start, self.ds0, self.ds0 * self.span
         level, crossings = start.orbit.level, start.orbit.crossings
         end, failures, arc, tried, steep, reach = 'points', 0, False, False, 0.0, self.ds_max
+        largest, before = start.orbit.x_p2p, None
         while len(out) < self.budget:
             self.floor = 0.5 * a.orbit.period / crossings
             if arc:
@@ -320,13 +322,15 @@ class _Tracer:
             p, loop, orbit = orbit
             b = self.secant(a, p, loop, orbit)
             out.append(BranchPoint(p, branch, orbit))
+            largest = max(largest, orbit.x_p2p)
             if b.tq * a.tq < 0 and arc:
-                events.append({'parameter': p, 'branch': branch, 'event': 'fold'})
+                if orbit.x_p2p > largest / 20:   # not the vertical stretch over a Hopf point
+                    events.append({'parameter': _turning(before, a, b), 'branch': branch, 'event': 'fold'})
                 direction = -direction
             if orbit.stable != a.orbit.stable:
                 events.append({'parameter': 0.5 * (p + a.p), 'branch': branch, 'event': 'stability',
                                'multiplier': _crossing_kind(orbit if not orbit.stable else a.orbit)})
-            a = b
+            before, a = a, b
             if orbit.x_p2p < DEAD:
                 end = 'dies'
                 break
@@ -340,8 +344,11 @@ class _Tracer:
                 arc = False                    # past the fold: steps in p again
             grow = 1.5 if orbit.iterations <= 4 else 1.0
             ds, dp = min(reach, ds * grow), min(self.ds_max * self.span, dp * grow)
-        events.append({'parameter': a.p, 'branch': branch, 'event': end, 'x_p2p_m': a.orbit.x_p2p,
-                       'max_multiplier_modulus': a.orbit.largest_multiplier})
+        at = _rest_reached(out) if end == 'lost' else None
+        if at is not None:
+            end = 'dies'
+        events.append({'parameter': a.p if at is None else at, 'branch': branch, 'event': end,
+                       'x_p2p_m': a.orbit.x_p2p, 'max_multiplier_modulus': a.orbit.largest_multiplier})
         return out
 
     def solve(self, a: _Point, p_pred: float, u_pred: np.ndarray, level: float, crossings: int,
@@ -360,6 +367,8 @@ class _Tracer:
                         if c.code != 'crossing':
                             break
                         u_pred = c.state
+                if u_pred[3] > 0.0:          # the section through the predicted state, half a sample back
+                    level = u_pred[1] - 0.5 * loop_pred.dt * u_pred[3]
                 try:
                     return self.correct(p_pred, u_pred, level, crossings, tu, a.tq, fixed=fixed, retake=retake)
                 except _Window as jump:
@@ -415,6 +424,34 @@ def _bordered(J: np.ndarray, w: np.ndarray, col: np.ndarray) -> np.ndarray:
     return A
 
 
+def _turning(before: _Point | None, a: _Point, b: _Point) -> float:
+    """The parameter at a fold between solved points ``a`` and ``b`` (p turns back at ``b``):
+    the vertex of the parabola p(arclength) through ``before``, ``a``, ``b`` (``b``'s p without
+    ``before``)."""
+    if before is None or not (a.step > 0 and b.step > 0):
+        return b.p
+    s = np.array([0.0, a.step, a.step + b.step])
+    c2, c1, c0 = np.polyfit(s, [before.p, a.p, b.p], 2)
+    if c2 == 0.0 or not 0.0 <= -c1 / (2 * c2) <= s[2]:
+        return b.p
+    return float(c0 - c1 * c1 / (4 * c2))
+
+
+def _rest_reached(points: list[BranchPoint]) -> float | None:
+    """Where a branch whose orbits shrink towards rest reaches it, or None: the parameter at which
+    the squared cart amplitude of its last two points extrapolates to 0 (near a Hopf point the
+    amplitude grows as the square root of the distance), when the last orbit is smaller than the
+    one before and below 1/20 of the branch's largest."""
+    if len(points) < 2:
+        return None
+    a, b = points[-2], points[-1]
+    largest = max(bp.orbit.x_p2p for bp in points)
+    if not (b.orbit.x_p2p < a.orbit.x_p2p and b.orbit.x_p2p < largest / 20):
+        return None
+    slope = (b.orbit.x_p2p ** 2 - a.orbit.x_p2p ** 2) / (b.parameter - a.parameter)
+    return b.parameter - b.orbit.x_p2p ** 2 / slope
+
+
 def _near_one(o: Orbit, within: float = 0.15) -> bool:
     """Whether a real multiplier of ``o`` lies within ``within`` of +1 (as at a fold)."""
     m = o.multipliers
@@ -430,7 +467,8 @@ def _crossing_kind(unstable: Orbit) -> str:
 
 def trace(make_loop: Callable[[float], LoopNumbers], start: float, stop: float, points: int = 100,
           probes: int = 6, partners: bool = True, tol: float = 1e-7, growth: float = 4.0,
-          progress: Callable[[str], None] | None = None, executor=None) -> Branches:
+          progress: Callable[[str], None] | None = None, executor=None,
+          orbits: Sequence[tuple[float, Orbit]] = ()) -> Branches:
     """Branches of orbits for the parameter in [start, stop].
 
     ``make_loop(p)`` gives the loop at parameter p. The first step is 1/(``points`` - 1) of the
@@ -442,10 +480,19 @@ def trace(make_loop: Callable[[float], LoopNumbers], start: float, stop: float, 
     where the corrector converges fast (1: every step the first one). ``executor``: a
     ``concurrent.futures`` executor (a Dask cluster's) on which the Jacobians' columns run, in
     tasks (:func:`orbit.return_map_jacobian`); the branches are the same as without it.
+    ``orbits``: (parameter, orbit) pairs found otherwise (an unstable orbit on a basin's edge)
+    whose branches are traced first.
     """
     lo, hi = min(start, stop), max(start, stop)
     tr = _Tracer(make_loop, lo, hi, max(points, 2), 1.0 / (max(points, 2) - 1), tol, growth, executor)
     say = progress or (lambda text: None)
+    for p, o in orbits:
+        if lo <= p <= hi and not tr.covered(p, o.x_p2p):
+            say(f'branch from a given orbit at {p:.4g}')
+            try:
+                tr.add_branch(p, make_loop(p), o)
+            except OrbitError:
+                continue
     grid = [lo + (hi - lo) * i / max(probes - 1, 1) for i in range(max(probes, 1))]
     for i, p in enumerate(grid):
         loop = make_loop(p)

@@ -427,14 +427,19 @@ def shrunk(loop: LoopNumbers, orbit: Orbit, factor: float) -> np.ndarray:
 
 
 def resized(z: np.ndarray, delay_from: int, delay_to: int) -> np.ndarray:
-    """Loop state ``z`` with ``delay_from`` history rows carried to ``delay_to`` rows (the
-    oldest row repeated, or the oldest rows dropped)."""
+    """Loop state ``z`` with ``delay_from`` history rows carried to ``delay_to`` rows (rows
+    older than the oldest extrapolated linearly from the two oldest, or the oldest rows dropped)."""
     if delay_from == delay_to:
         return z.copy()
     rows = z[LS_HISTORY:LS_HISTORY + 4 * delay_from].reshape(delay_from, 4)
     if delay_to > delay_from:
-        first = rows[:1] if delay_from else z[[LS_LAST, LS_LAST + 1, LS_RATE, LS_RATE + 1]][None, :]
-        rows = np.vstack([np.repeat(first, delay_to - delay_from, axis=0), rows])
+        if delay_from > 1:                 # the readings before the oldest, extrapolated in time
+            back = np.arange(delay_to - delay_from, 0, -1)[:, None]
+            older = rows[:1] - back * (rows[1:2] - rows[:1])
+        else:
+            first = rows[:1] if delay_from else z[[LS_LAST, LS_LAST + 1, LS_RATE, LS_RATE + 1]][None, :]
+            older = np.repeat(first, delay_to - delay_from, axis=0)
+        rows = np.vstack([older, rows])
     else:
         rows = rows[delay_from - delay_to:]
     return np.concatenate([z[:LS_HISTORY], rows.ravel(), z[LS_HISTORY + 4 * delay_from:]])
