@@ -318,9 +318,16 @@ class _Tracer:
                     end = 'lost'
                     break
                 continue
-            failures, tried = 0, False
             p, loop, orbit = orbit
             b = self.secant(a, p, loop, orbit)
+            if arc and b.step < 0.01 * ds:      # the corrector came back to the point it left
+                failures += 1
+                ds, dp = 0.5 * ds, 0.5 * dp
+                if failures > 4 or ds < self.ds_min:
+                    end = 'lost'
+                    break
+                continue
+            failures, tried = 0, False
             out.append(BranchPoint(p, branch, orbit))
             largest = max(largest, orbit.x_p2p)
             if b.tq * a.tq < 0 and arc:
