@@ -69,21 +69,8 @@ from independent import rigsim as rs
 from ipfric_core.cli import _sweep_base
 from ipfric_core.design.basin import basin_edge
 from ipfric_core.design.orbit import loop_numbers
+from ipfric_core.physics import friction as fr
 from ipfric_core.physics.closedloop import LS_HISTORY
-from ipfric_core.physics.friction import (
-    EXPONENTIAL,
-    FP_ASYM,
-    FP_ASYM_V,
-    FP_DELTA,
-    FP_EPS,
-    FP_FN,
-    FP_GAMMA,
-    FP_MODEL,
-    FP_MU_C,
-    FP_MU_S,
-    FP_SMOOTH,
-    FP_V_S,
-)
 
 CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'fig9_new_gain_exponential.yaml'
 RIG = rs.RIGS['quanser']
@@ -197,11 +184,12 @@ def test_both_sides_describe_the_same_loop(base, rig_edge):
     M, m, g = RIG['M'], RIG['m'], RIG['g']
     assert loop.plant == pytest.approx((M, m, RIG['l'], g, RIG['alpha'], RIG['beta']), rel=1e-15)
     f = loop.friction
-    assert f[FP_MODEL] == EXPONENTIAL and f[FP_SMOOTH] == 1.0 and f[FP_DELTA] == DELTA and f[FP_GAMMA] == 2.0
-    assert (f[FP_EPS], f[FP_MU_S], f[FP_MU_C], f[FP_V_S]) == pytest.approx(
+    assert f[fr.FP_MODEL] == fr.EXPONENTIAL and f[fr.FP_SMOOTH] == 1.0
+    assert f[fr.FP_DELTA] == DELTA and f[fr.FP_GAMMA] == 2.0
+    assert (f[fr.FP_EPS], f[fr.FP_MU_S], f[fr.FP_MU_C], f[fr.FP_V_S]) == pytest.approx(
         (RIG['eps'], RIG['mu_s'], RIG['mu_c'], RIG['v_s']), rel=1e-15)
-    assert f[FP_FN] == pytest.approx((M + m) * g, rel=1e-14)
-    assert f[FP_ASYM] == f[FP_ASYM_V] == 0.0
+    assert f[fr.FP_FN] == pytest.approx((M + m) * g, rel=1e-14)
+    assert f[fr.FP_ASYM] == f[fr.FP_ASYM_V] == 0.0
     assert loop.extra_force[0] == loop.extra_force[3] == 0.0            # no cogging, no offset force
     assert loop.gain == GAIN
     a, dt, delay, vlimit = loop.control

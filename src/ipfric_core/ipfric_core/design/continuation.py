@@ -307,6 +307,10 @@ class _Tracer:
             if last:
                 p_pred = min(max(p_pred, self.lo), self.hi)
             orbit = self.solve(a, p_pred, u_pred, level, crossings, fixed=last or not arc, retake=failures == 0)
+            if orbit is not None:
+                b = self.secant(a, *orbit)
+                if arc and b.step < 0.01 * ds:      # the corrector came back to the point it left
+                    orbit = None
             if orbit is None:
                 if not arc and not tried and a.step > 0:
                     arc, tried, steep, reach = True, True, abs(a.tq), max(a.step, self.ds_max)
@@ -319,14 +323,6 @@ class _Tracer:
                     break
                 continue
             p, loop, orbit = orbit
-            b = self.secant(a, p, loop, orbit)
-            if arc and b.step < 0.01 * ds:      # the corrector came back to the point it left
-                failures += 1
-                ds, dp = 0.5 * ds, 0.5 * dp
-                if failures > 4 or ds < self.ds_min:
-                    end = 'lost'
-                    break
-                continue
             failures, tried = 0, False
             out.append(BranchPoint(p, branch, orbit))
             largest = max(largest, orbit.x_p2p)
