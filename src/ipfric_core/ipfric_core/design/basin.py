@@ -42,14 +42,14 @@ def fate(loop: LoopNumbers, z: np.ndarray | None = None, duration: float = 40.0,
     :data:`GROWN`-fold or after ``duration`` is still as large as at first: it hunts). The swing
     is the larger of the cart's [m] and the angle's [rad] peak-to-peak over a ``window`` [s]."""
     z = loop.start.copy() if z is None else np.array(z, dtype=float)
-    first = swing = None
+    first, swing = -1.0, 0.0
     for _ in range(max(1, int(round(duration / window)))):
         c = return_map(loop, z, math.inf, 1, max_period=window)
         if c.code != 'no_crossing':
             return LEAVES
         z = c.state
         swing = max(c.x_p2p, c.theta_p2p)
-        if first is None:
+        if first < 0.0:
             first = swing
             if swing == 0.0:
                 return SETTLES
@@ -73,8 +73,8 @@ class Edge:
     why: str = ''
 
     def summary(self) -> dict:
-        out = {'settles_below_rad': self.settles_below, 'leaves_from_rad': self.leaves_from, 'runs': self.runs,
-               'orbit': self.orbit.summary() if self.orbit else None}
+        out: dict[str, object] = {'settles_below_rad': self.settles_below, 'leaves_from_rad': self.leaves_from,
+                                  'runs': self.runs, 'orbit': self.orbit.summary() if self.orbit else None}
         if self.orbit:
             out['threshold_over_orbit_amplitude'] = self.settles_below / (0.5 * self.orbit.theta_p2p)
         else:
