@@ -27,9 +27,9 @@ from dataclasses import replace
 import pytest
 
 from ipfric_core.analysis.sweep import threshold_angle
+from ipfric_core.cli import _orbit_loop, _sweep_base
 from ipfric_core.design.basin import LEAVES, SETTLES, basin_edge, fate, shape_threshold
-from ipfric_core.design.orbit import loop_numbers, return_map
-from ipfric_core.run.scenario import load_scenario
+from ipfric_core.design.orbit import return_map
 
 CASES = {
     'tanh': ('config/fig9_new_gain_exponential.yaml', 'tanh', 0.09),
@@ -37,24 +37,17 @@ CASES = {
 }
 
 
-def scenario(config, smoothing):
-    scn = load_scenario(config)
-    scn = replace(scn, sim=replace(scn.sim, cart_resolution=0.0, angle_resolution=0.0))
-    return replace(scn, friction=scn.friction.replace(smoothing=smoothing)) if smoothing else scn
-
-
-def loops(scn, delay):
-    def loop_at(theta0):
-        s = replace(scn, sim=replace(scn.sim, theta0=theta0))
-        return loop_numbers(s.make_rig().loop_spec(), s.make_controller().loop_spec(), delay)
-    return loop_at
+def loops(config, smoothing, delay, cutoff_hz=None):
+    """theta0 [rad] -> the loop of ``config`` with exact sensors started there."""
+    base = _sweep_base(config, 'exact', smoothing, cutoff_hz)
+    return lambda theta0: _orbit_loop(base, 'theta0', theta0, delay)
 
 
 @pytest.fixture(scope='module')
 def edges():
     out = {}
     for name, (config, smoothing, delay) in CASES.items():
-        loop_at = loops(scenario(config, smoothing), delay)
+        loop_at = loops(config, smoothing, delay)
         out[name] = loop_at, basin_edge(loop_at, math.radians(0.001), math.radians(2.0))
     return out
 
@@ -97,7 +90,7 @@ def test_the_run_at_the_edge_lingers_on_the_orbit(edges):
 def test_the_sweep_threshold_brackets_the_edge(edges):
     """`sweep --threshold` (its own classifier of 20 s windows) finds the same threshold."""
     config, smoothing, delay = CASES['tanh']
-    scn = scenario(config, smoothing)
+    scn = _sweep_base(config, 'exact', smoothing)
     base = replace(scn, controller=replace(scn.controller, delay=delay))
     res = threshold_angle(base, math.radians(0.05), math.radians(0.1), 40.0)
     edge = edges['tanh'][1]
@@ -109,9 +102,7 @@ def test_figure_8b_edge_has_no_orbit_on_it():
     """Gain (15) on the dynamic plant, no delay (Figure 8(b)): starts settle up to about 3.1e-5
     rad and go to the stable cycle above, but the runs at the edge creep without swinging
     through the middle of a swing: no periodic orbit bounds that basin."""
-    scn = scenario('config/fig8_old_gain_dynamic.yaml', None)
-    scn = replace(scn, controller=replace(scn.controller, cutoff_hz=0.0))
-    loop_at = loops(scn, 0.0)
+    loop_at = loops('config/fig8_old_gain_dynamic.yaml', None, 0.0, cutoff_hz=0.0)
     assert fate(loop_at(1e-6), duration=80.0) == SETTLES and fate(loop_at(1e-3), duration=80.0) == LEAVES
     edge = basin_edge(loop_at, 1e-6, 1e-3, rtol=1e-6, duration=80.0)
     assert 3.0e-5 < edge.settles_below < 3.3e-5

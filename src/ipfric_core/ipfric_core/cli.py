@@ -676,9 +676,10 @@ def _orbit_loop(base, name: str, value: float, delay: float | None = None):
 
     from .analysis.sweep import scenario_at
     from .design.orbit import loop_numbers
-    scn = base if name in ('delay', 'theta0') else scenario_at(base, name, value)
     if name == 'theta0':
         scn = replace(base, sim=replace(base.sim, theta0=value))
+    else:
+        scn = base if name == 'delay' else scenario_at(base, name, value)
     return loop_numbers(scn.make_rig().loop_spec(), scn.make_controller().loop_spec(),
                         value if name == 'delay' else base.controller.delay if delay is None else delay)
 

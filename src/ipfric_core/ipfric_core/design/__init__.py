@@ -84,6 +84,7 @@ _WHERE = {
     'finish_orbit': 'orbit',
     'return_map_jacobian': 'orbit',
     'basin_edge': 'basin',
+    'bordered': 'orbit',
     'friction_estimates': 'reports',
     'friction_loop': 'describing',
     'friction_to_state': 'describing',

@@ -96,10 +96,10 @@ def _bisect(settles: Callable[[float], int], lo: float, hi: float, rtol: float) 
     return lo, hi, runs
 
 
-def _lingering(loop: LoopNumbers, passes: int = 60) -> tuple[list[tuple[float, np.ndarray, int, float]], float]:
+def _lingering(loop: LoopNumbers, passes: int = 60) -> list[tuple[float, np.ndarray, int, float]]:
     """Passes of the loop from its start through the middle of its swing over the first second:
     (change over the pass [scaled], state, samples, centre of the angle [rad]) for each, fewest change
-    first, and the level [rad]."""
+    first."""
     z = loop.start.copy()
     c = return_map(loop, z, math.inf, 1, max_period=1.0)
     z, level = c.state, c.theta_center
@@ -112,7 +112,7 @@ def _lingering(loop: LoopNumbers, passes: int = 60) -> tuple[list[tuple[float, n
         if k > 0:                                        # the first pass starts off the section
             found.append((float(np.max(np.abs(c.state[:4] - z[:4]) / scale)), z.copy(), c.samples, c.theta_center))
         z = c.state
-    return sorted(found, key=lambda f: f[0]), level
+    return sorted(found, key=lambda f: f[0])
 
 
 def basin_edge(loop_at: Callable[[float], LoopNumbers], lo: float, hi: float, rtol: float = 1e-10,
@@ -131,7 +131,7 @@ def basin_edge(loop_at: Callable[[float], LoopNumbers], lo: float, hi: float, rt
     lo, hi, runs = _bisect(lambda a: fate(loop_at(a), duration=duration), lo, hi, rtol)
     loop = loop_at(lo)
     why = 'the run at the edge makes no pass through the middle of its swing'
-    for _, z, samples, centre in _lingering(loop)[0][:TRIES]:
+    for _, z, samples, centre in _lingering(loop)[:TRIES]:
         on = return_map(loop, z, centre, 1, min_period=0.25 * samples * loop.dt)
         try:
             o = shoot(loop, on.state, centre, 1, min_period=0.5 * samples * loop.dt)

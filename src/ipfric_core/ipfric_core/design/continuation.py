@@ -36,6 +36,7 @@ from .orbit import (
     LoopNumbers,
     Orbit,
     OrbitError,
+    bordered,
     entry_scale,
     find_orbit,
     finish_orbit,
@@ -130,7 +131,6 @@ class _Point:
     tu: np.ndarray
     tq: float
     step: float = 0.0
-
 
 
 def _layout(loop: LoopNumbers) -> tuple[int, int]:
@@ -233,7 +233,7 @@ class _Tracer:
                     raise OrbitError(f'the corrector stalled at residual {res:.3g}')
                 J, col = self.derivatives(here, p, u, level, crossings, idx, scale, column=not fixed)
                 taken += 1
-                A = np.vstack([_bordered(J, w, col), np.zeros(n + 2)])
+                A = np.vstack([bordered(J, w, col), np.zeros(n + 2)])
                 if fixed:
                     A[n + 1, n + 1] = 1.0
                 else:
@@ -254,7 +254,7 @@ class _Tracer:
         J, col = self.derivatives(loop, p, u, orbit.level, orbit.crossings, idx, scale)
         w = motion(loop, u, idx) / scale
         n = len(idx)
-        null = np.linalg.svd(_bordered(J, w, col))[2][-1]
+        null = np.linalg.svd(bordered(J, w, col))[2][-1]
         tu = np.zeros(len(orbit.state))
         tu[idx] = null[:n] * scale
         tq = float(null[n + 1])
@@ -414,17 +414,6 @@ class _Tracer:
         near = 0.03 * self.span
         return any(abs(bp.parameter - p) <= near and abs(bp.orbit.x_p2p - x_p2p) <= 0.05 * max(x_p2p, 1e-12)
                    for bp in self.result.points)
-
-
-def _bordered(J: np.ndarray, w: np.ndarray, col: np.ndarray) -> np.ndarray:
-    """[[J - I, w, dP/dq], [w / |w|, 0, 0]]: the orbit equations' Jacobian in (v, s, q) with the
-    phase condition, (n + 1) x (n + 2)."""
-    n = len(w)
-    A = np.zeros((n + 1, n + 2))
-    A[:n, :n] = J - np.eye(n)
-    A[:n, n], A[:n, n + 1] = w, col
-    A[n, :n] = w / max(np.linalg.norm(w), 1e-300)
-    return A
 
 
 def _turning(before: _Point | None, a: _Point, b: _Point) -> float:

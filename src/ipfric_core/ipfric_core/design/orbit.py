@@ -308,11 +308,9 @@ def shoot(loop: LoopNumbers, z: np.ndarray, level: float, crossings: int = 1, to
                                 executor=executor)
         if res < tol:
             return finish_orbit(loop, z, level, crossings, c, J, w, s, res, it)
-        A = np.zeros((n + 1, n + 1))
-        A[:n, :n] = J - np.eye(n)
-        A[:n, n] = A[n, :n] = w / scale / max(np.linalg.norm(w / scale), 1e-300)
+        A = bordered(J, w / scale, np.zeros(n))[:, :n + 1]          # p held: no parameter column
         step = np.linalg.lstsq(A, np.concatenate([-g, [0.0]]), rcond=None)[0]
-        du, ds = step[:n] * scale, step[n] / max(np.linalg.norm(w / scale), 1e-300)
+        du, ds = step[:n] * scale, step[n]
         lam = 1.0
         for _ in range(12):           # damped: the first step that lowers the residual
             zt = z.copy()
@@ -328,6 +326,17 @@ def shoot(loop: LoopNumbers, z: np.ndarray, level: float, crossings: int = 1, to
             raise OrbitError(f'Newton stalled at residual {res:.3g} (iteration {it})')
         z, s = zt, s + lam * ds
     raise OrbitError(f'Newton did not converge in {max_iter} iterations (residual {res:.3g})')
+
+
+def bordered(J: np.ndarray, w: np.ndarray, col: np.ndarray) -> np.ndarray:
+    """[[J - I, w, dP/dq], [w / |w|, 0, 0]]: the orbit equations' Jacobian in (v, s, q) (scaled
+    free entries, phase shift [s], parameter) with the phase condition, (n + 1) x (n + 2)."""
+    n = len(w)
+    A = np.zeros((n + 1, n + 2))
+    A[:n, :n] = J - np.eye(n)
+    A[:n, n], A[:n, n + 1] = w, col
+    A[n, :n] = w / max(np.linalg.norm(w), 1e-300)
+    return A
 
 
 def passes_apart(loop: LoopNumbers, z: np.ndarray, moved: np.ndarray, steps: np.ndarray, level: float,
