@@ -99,6 +99,7 @@ class Problem:
         self.n_samples = int(sum(np.sum(w.stop - w.start) for _, w, _ in self.blocks))
         self._kept: dict = {}
         self._base: dict = {}
+        self._cart: Problem | None = None
 
     def screen(self, samples: int = SCREEN_SAMPLES) -> Problem:
         """This problem on every k-th window of each block (k the smallest that keeps a block within
@@ -117,7 +118,7 @@ class Problem:
         angle: the cart's error is what they change; the angle's weighs THETA_WEIGHT^2 as much)."""
         if len(self.blocks) == 1:
             return self
-        if not hasattr(self, '_cart'):
+        if self._cart is None:
             self._cart = Problem(self.rec, self.blocks[:1], self.subset)
         return self._cart
 
