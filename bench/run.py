@@ -21,23 +21,19 @@ from pathlib import Path
 
 import numpy as np
 
-from ipfric_core.analysis.montecarlo import parse_spread, run_chunk, run_montecarlo, spread_draw
 from ipfric_core.analysis.oscillation import classify, crossing_period
-from ipfric_core.analysis.sweep import cell_scenario, parse_range, scenario_at, sweep
-from ipfric_core.design.paperconfig import REPO_ROOT
-from ipfric_core.executor import make_executor
+from ipfric_core.constants import REPO_ROOT
 from ipfric_core.physics.closedloop import run_closed_loop
 from ipfric_core.run.scenario import load_scenario
+from ipfric_core.study.executor import make_executor
+from ipfric_core.study.montecarlo import parse_spread, run_chunk, run_montecarlo, spread_draw
+from ipfric_core.study.sweep import parse_range, sweep
+from ipfric_core.study.variants import cell_scenario, exact_sensors, scenario_at
 
 CONFIG = REPO_ROOT / 'config'
 EMPS = REPO_ROOT.parent / 'shared' / 'data' / 'emps'
 ACCURACY = 0.005          # limit-cycle amplitude and period within 0.5 % of scipy
 MUJOCO_STEPS = (1e-3, 5e-4, 2.5e-4)
-
-
-def exact(s):
-    """Scenario with exact sensors (no encoder quantization)."""
-    return replace(s, sim=replace(s.sim, cart_resolution=0.0, angle_resolution=0.0))
 
 
 def timed(fn, repeat: int = 1):
@@ -94,7 +90,7 @@ def bench_closed_loop(quick: bool) -> list[dict]:
     t_sci, _ = timed(lambda: run_scipy(base, duration))
     # accuracy: exact sensors, where the limit cycle is a well-conditioned number (with the
     # encoders it moves by a few % between converged integrators); 30 s for several periods
-    ex, span = exact(base), 2.0 if quick else 30.0
+    ex, span = exact_sensors(base), 2.0 if quick else 30.0
     settle = span / 3
     ref = cycle(run_scipy(ex, span), settle)
     ours = cycle(run_closed_loop(ex.make_rig(), ex.make_controller(), span), settle)
@@ -139,7 +135,7 @@ def _mujoco_cell(args):
 
 
 def bench_sweep(quick: bool) -> list[dict]:
-    base = exact(load_scenario(CONFIG / 'fig9_new_gain_exponential.yaml'))
+    base = exact_sensors(load_scenario(CONFIG / 'fig9_new_gain_exponential.yaml'))
     taus = parse_range('0:0.01:0.005' if quick else '0:0.14:0.005')
     ths = parse_range('0:1:0.5' if quick else '0:12:0.5')
     duration = 2.0 if quick else 20.0
@@ -281,12 +277,12 @@ def bench_identify(quick: bool) -> list[dict]:
 def bench_orbit(quick: bool) -> list[dict]:
     """./ipfric orbit on Figure 7 (exact sensors): one orbit beside the 120 s run whose cycle it
     predicts, and the branch over the delay 0-0.14 s (100 points) beside 100 runs of 20 s."""
-    from ipfric_core.cli import _orbit_loop
-    from ipfric_core.design.continuation import trace
-    from ipfric_core.design.orbit import find_orbit, simulated_cycle
-    base = exact(load_scenario(CONFIG / 'fig7_old_gain_exponential.yaml'))
-    find_orbit(_orbit_loop(base, 'delay', 0.0))                       # compile / load the cache
-    t_orbit, orbit = timed(lambda: find_orbit(_orbit_loop(base, 'delay', 0.0)), repeat=3)
+    from ipfric_core.study.continuation import trace
+    from ipfric_core.study.orbit import find_orbit, simulated_cycle
+    from ipfric_core.study.variants import loop_of
+    base = exact_sensors(load_scenario(CONFIG / 'fig7_old_gain_exponential.yaml'))
+    find_orbit(loop_of(base, 'delay', 0.0))                       # compile / load the cache
+    t_orbit, orbit = timed(lambda: find_orbit(loop_of(base, 'delay', 0.0)), repeat=3)
     long_run = 20.0 if quick else 120.0
     t_sim, sim = timed(lambda: simulated_cycle(base.make_rig(), base.make_controller(), long_run))
     err = max(abs(orbit.x_p2p / sim['x_p2p_m'] - 1), abs(orbit.period / sim['period_s'] - 1))
@@ -295,7 +291,7 @@ def bench_orbit(quick: bool) -> list[dict]:
              'ipfric': f'{t_orbit:.3g} s', 'ratio': t_sim / t_orbit, 'target': '< 1 s, within 0.1 % of the run',
              'met': t_orbit < 1.0 and err < 1e-3}]
     stop, points, runs = (0.01, 5, 5) if quick else (0.14, 100, 100)
-    t_branch, found = timed(lambda: trace(lambda v: _orbit_loop(base, 'delay', v), 0.0, stop, points))
+    t_branch, found = timed(lambda: trace(lambda v: loop_of(base, 'delay', v), 0.0, stop, points))
     cells = [scenario_at(base, 'delay', stop * i / (runs - 1)) for i in range(runs)]
     t_runs, _ = timed(lambda: [run_closed_loop(c.make_rig(), c.make_controller(), 20.0) for c in cells])
     per_100 = 100.0 * t_branch / max(len(found.points), 1)
@@ -314,17 +310,17 @@ def bench_basin() -> dict:
     """The unstable orbit on the edge of the upright's basin (gain (23), exponential friction with
     tanh(100 v), delay 90 ms, exact sensors) beside the bisection of theta0 by `sweep --threshold`:
     the starts of the orbit's shape scaled by f settle below f* and fall above; f* against 1."""
-    from ipfric_core.analysis.sweep import threshold_angle
-    from ipfric_core.cli import _orbit_loop
-    from ipfric_core.design.basin import basin_edge, shape_threshold
-    base = exact(load_scenario(CONFIG / 'fig9_new_gain_exponential.yaml'))
+    from ipfric_core.study.basin import basin_edge, shape_threshold
+    from ipfric_core.study.sweep import threshold_angle
+    from ipfric_core.study.variants import loop_of
+    base = exact_sensors(load_scenario(CONFIG / 'fig9_new_gain_exponential.yaml'))
     base = replace(base, friction=base.friction.replace(smoothing='tanh'))
     base = scenario_at(base, 'delay', 0.09)
     t_bisect, sweep = timed(lambda: threshold_angle(base, math.radians(0.05), math.radians(0.1), 40.0))
 
     def edge_and_shape():
-        edge = basin_edge(lambda a: _orbit_loop(base, 'theta0', a), 1e-4, 0.03)
-        return edge, shape_threshold(_orbit_loop(base, 'theta0', edge.settles_below), edge.orbit)
+        edge = basin_edge(lambda a: loop_of(base, 'theta0', a), 1e-4, 0.03)
+        return edge, shape_threshold(loop_of(base, 'theta0', edge.settles_below), edge.orbit)
     t_edge, (edge, (f_lo, f_hi)) = timed(edge_and_shape)
     o = edge.orbit
     off = max(abs(f_lo - 1), abs(f_hi - 1))

@@ -15,7 +15,8 @@ from pathlib import Path
 import pytest
 
 from ipfric_core.analysis.bagread import read_run
-from ipfric_core.run.runner import ROOT, Run
+from ipfric_core.constants import REPO_ROOT as ROOT
+from ipfric_core.run.runner import Run
 
 pytestmark = pytest.mark.ros
 CUTS, FLIPS, SEED = 200, 200, 12

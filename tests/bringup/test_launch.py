@@ -13,8 +13,9 @@ import numpy as np
 import pytest
 
 from ipfric_core.analysis.bagread import read_run
+from ipfric_core.constants import REPO_ROOT as ROOT
 from ipfric_core.run.nodes import NODES, node_parameters, ros_args, write_run_scenario
-from ipfric_core.run.runner import ROOT, pick_domain, ros_environment, run
+from ipfric_core.run.runner import pick_domain, ros_environment, run
 
 pytestmark = pytest.mark.ros
 

@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 from conftest import ROOT
 
+from ipfric_core.analysis.records import load_csv, load_emps, write_csv
 from ipfric_core.cli import main
 from ipfric_core.design.estimation import load_table5, load_table6
 from ipfric_core.ident.equation_error import identify, identify_steady
 from ipfric_core.ident.excitation import cart_alone_run
-from ipfric_core.ident.records import load_csv, load_emps, write_csv
 from ipfric_core.ident.redesign import close_the_loop
 from ipfric_core.physics.params import ConfigError, FrictionParams, PlantParams
 from ipfric_core.physics.rig import PlantTruth
@@ -62,7 +62,7 @@ def test_csv_bad_input_is_refused_with_the_problem(tmp_path, clean, mangle, mess
 
 
 def test_angle_in_degrees_is_refused_and_uneven_sampling_taken(tmp_path, clean):
-    deg = np.column_stack([clean.t, clean.x, clean.u, np.full(len(clean.t), 15.0)])
+    deg = np.column_stack([clean.t, clean.x, clean.u, 15.0 + 5.0 * np.sin(clean.t)])
     np.savetxt(tmp_path / 'deg.csv', deg, delimiter=',', header='t,x,voltage,theta', comments='')
     with pytest.raises(ConfigError, match='degrees'):
         load_csv(tmp_path / 'deg.csv', PLANT)

@@ -7,8 +7,8 @@ import pytest
 from rosrun import CONFIG
 
 from ipfric_core.analysis.oscillation import classify
+from ipfric_core.analysis.records import load_bag
 from ipfric_core.cli import main
-from ipfric_core.ident.records import load_bag
 from ipfric_core.physics.closedloop import run_closed_loop
 from ipfric_core.run.runner import run
 from ipfric_core.run.scenario import load_scenario

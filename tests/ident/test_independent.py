@@ -14,10 +14,10 @@ import math
 import pytest
 from independent import rigsim
 
+from ipfric_core.analysis.records import load
 from ipfric_core.cli import main
 from ipfric_core.ident.ladder import TYPICAL, run_ladder
 from ipfric_core.ident.model import load_declared
-from ipfric_core.ident.records import load
 from ipfric_core.run.scenario import load_scenario
 
 

@@ -15,6 +15,7 @@ from ipfric_core.analysis.bagread import read_run
 from ipfric_core.physics.closedloop import run_closed_loop
 from ipfric_core.run.runner import run
 from ipfric_core.run.scenario import load_scenario
+from ipfric_core.study.variants import exact_sensors
 
 DURATION = {'fig7_old_gain_exponential': 15.0, 'fig9_new_gain_exponential': 12.0,
             'fig10_new_gain_dynamic': 12.0}
@@ -179,12 +180,11 @@ def test_truncated_bag_is_read_up_to_its_last_complete_record(runs, tmp_path):
 @pytest.mark.slow
 def test_ros_sweep_gives_the_offline_classes(tmp_path):
     """`./ipfric sweep --ros`: cells through the ROS loop classify exactly as the offline core."""
-    from dataclasses import replace
 
     from ipfric_core.analysis.recorded_run import analyze_run
-    from ipfric_core.analysis.sweep import sweep
+    from ipfric_core.study.sweep import sweep
     s = load_scenario(CONFIG / 'fig9_new_gain_exponential.yaml')
-    s = replace(s, sim=replace(s.sim, cart_resolution=0.0, angle_resolution=0.0))
+    s = exact_sensors(s)
     taus, ths = [0.0, 0.06], [3.0]
     ros = sweep(s, taus, ths, 12.0, tmp_path / 'ros', ros=True)
     off = sweep(s, taus, ths, 12.0, tmp_path / 'off', workers=1)

@@ -9,7 +9,8 @@ import pytest
 from rosrun import scenario_file, start_node
 
 from ipfric_core.analysis.bagread import read_run
-from ipfric_core.run.runner import ROOT, Run, pick_domain
+from ipfric_core.constants import REPO_ROOT as ROOT
+from ipfric_core.run.runner import Run, pick_domain
 
 
 def wait_for_start(log, proc, timeout=60.0):

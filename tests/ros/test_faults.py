@@ -17,7 +17,8 @@ import pytest
 from rosrun import Peer, scenario_file
 
 from ipfric_core.analysis.bagread import read_run
-from ipfric_core.run.runner import EXIT_FAULT, ROOT, Run
+from ipfric_core.constants import REPO_ROOT as ROOT
+from ipfric_core.run.runner import EXIT_FAULT, Run
 
 pytestmark = pytest.mark.ros
 CFG = ROOT / 'config' / 'default.yaml'

@@ -1,7 +1,8 @@
-"""ipfric_core: the physics, design, analysis and identification of ipfric, without ROS.
+"""ipfric_core: the physics, design, analysis, studies and identification of ipfric, without ROS.
 
 Layers, each importing only those before it:
-constants < physics < design < run < analysis < ident; ``cli`` parses the command line and prints.
+constants < physics < {analysis, design} < run < study < ident < cli; ``cli`` parses the
+command line and prints.
 """
 
-__all__ = ['constants', 'physics', 'design', 'run', 'analysis', 'ident', 'cli']
+__all__ = ['constants', 'physics', 'analysis', 'design', 'run', 'study', 'ident', 'cli']

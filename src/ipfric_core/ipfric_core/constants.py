@@ -9,6 +9,16 @@ importing ROS, the physics and the ROS simulator report the same end reasons, an
 from __future__ import annotations
 
 import math
+import os
+from pathlib import Path
+
+__all__ = ['REPO_ROOT', 'CLOCK', 'JOINT_STATES', 'PLANT_STATE', 'VOLTAGE_COMMAND', 'SAFETY_EVENT', 'CONTROLLER_GAIN',
+           'JOINT_NAMES', 'DURATION', 'FALLEN', 'TRACK_LIMIT', 'START', 'END', 'ABORT', 'LIMITS', 'TERMINAL_EVENTS',
+           'ANGLE_RESOLUTION_RAD', 'CART_RESOLUTION_M', 'TRACK_LIMIT_M', 'FALLEN_ANGLE_RAD']
+
+#: the checkout (or the workspace's symlinked source tree) ipfric runs from: its config/, runs/, ros2_ws/;
+#: IPFRIC_ROOT overrides it
+REPO_ROOT = Path(os.environ.get('IPFRIC_ROOT') or Path(__file__).resolve().parents[3])
 
 # -- topics of a run (``/clock`` is global, the others are relative to the node's namespace)
 CLOCK = '/clock'

@@ -4,6 +4,8 @@ from __future__ import annotations
 import importlib
 from collections.abc import Callable
 
+__all__ = ['lazy_getattr']
+
 
 def lazy_getattr(package: str, where: dict[str, str], modules: list[str]) -> Callable[[str], object]:
     """A module ``__getattr__`` (PEP 562) for ``package``: a name of ``where`` (name -> module)

@@ -48,6 +48,8 @@ from ..constants import CONTROLLER_GAIN, JOINT_STATES, PLANT_STATE, SAFETY_EVENT
 from ..physics.compiled import compiled
 from ..physics.params import ConfigError
 
+__all__ = ['RunData', 'read_run']
+
 
 @dataclass
 class RunData:

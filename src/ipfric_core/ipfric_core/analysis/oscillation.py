@@ -15,6 +15,8 @@ import numpy as np
 
 from ..constants import ANGLE_RESOLUTION_RAD, CART_RESOLUTION_M, FALLEN_ANGLE_RAD
 
+__all__ = ['CLASSES', 'Oscillation', 'crossing_period', 'classify', 'balanced_segments', 'regimes']
+
 CLASSES = ('settled', 'limit_cycle', 'irregular', 'growing', 'fallen')
 
 #: Largest coefficient of variation of the cycle-to-cycle periods of a limit cycle.

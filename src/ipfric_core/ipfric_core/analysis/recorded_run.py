@@ -27,6 +27,8 @@ from .bagread import RunData, read_run
 from .oscillation import balanced_segments, classify, regimes
 from .plots import overlay_figure, run_figure
 
+__all__ = ['analyze_run', 'overlay_runs', 'analyze_log']
+
 
 def _resolution(run: RunData) -> tuple[float, float]:
     sim = (run.config or {}).get('sim', {})
@@ -136,7 +138,7 @@ def analyze_log(path: str | Path, columns: dict | None = None, angle_zero: str =
     maps names to headers) cut into balanced stretches (|theta| < ``max_angle`` [rad] for
     at least ``min_duration`` [s]), each into regimes: class, time span, cart and angle
     peak-to-peak, period by zero crossings and by spectrum, sticking."""
-    from ..ident.records import load
+    from .records import load
     rec = load(path, None, columns, angle_zero=angle_zero)
     if rec.theta is None:
         raise ConfigError(f'{path}: no pendulum angle in the file; analyze needs t, x and theta '

@@ -12,6 +12,8 @@ import numpy as np
 import scipy.linalg
 from scipy.optimize import brentq
 
+__all__ = ['gain_critical_delay']
+
 
 def _mus(A, E, w) -> np.ndarray:
     n = A.shape[0]

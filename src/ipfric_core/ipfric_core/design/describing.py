@@ -41,6 +41,8 @@ from ..physics.friction import friction_force, friction_vector
 from ..physics.params import FrictionParams, PlantParams
 from .linearize import closed_form
 
+__all__ = ['friction_loop', 'predict_hunting', 'hunting_over_delays', 'hunting_over_gain_scales']
+
 #: frequencies searched for crossings of the negative real axis [rad/s]
 OMEGA_RANGE = (1e-2, 300.0)
 #: velocity amplitudes bracketing the harmonic balance [m/s]

@@ -13,6 +13,8 @@ import numpy as np
 
 from ..physics.params import ConfigError, PlantParams
 
+__all__ = ['load_table5', 'coulomb_viscous', 'load_table6', 'static_coefficient']
+
 
 def _rows(path: str | Path) -> list[dict]:
     path = Path(path)

@@ -13,6 +13,8 @@ from ..physics.friction import Friction
 from ..physics.params import FrictionParams, PlantParams
 from ..physics.plant import CartPendulum
 
+__all__ = ['jacobian', 'closed_form', 'characteristic_coefficients']
+
 
 def smooth_friction(friction: FrictionParams) -> FrictionParams:
     """The differentiable version of a friction law: tanh(delta v) for sgn(v)."""

@@ -11,6 +11,8 @@ import numpy as np
 from ..physics.params import Field, FrictionParams, PlantParams
 from .linearize import jacobian
 
+__all__ = ['STATE_WEIGHT', 'CONTROL_WEIGHT', 'controllability_matrix', 'design']
+
 #: bounds of the LQR weights: Q on (x, theta, x', theta') and R on the voltage
 STATE_WEIGHT = Field('', 0.0, 1e12, 'LQR state weight')
 CONTROL_WEIGHT = Field('', 0.0, 1e12, 'LQR control weight', lo_open=True)

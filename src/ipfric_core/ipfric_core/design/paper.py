@@ -1,3 +1,7 @@
+
+__all__ = ['GAIN_15_VISCOUS', 'GAIN_23_EXPONENTIAL', 'GAIN_25_DYNAMIC', 'EIG_DYNAMIC_GAIN_15', 'EIG_DYNAMIC_GAIN_25',
+           'DELTA_UNSTABLE_ABOVE', 'DELTA_COMPLEX_UNTIL', 'TAU_C_EXPONENTIAL', 'TAU_C_DYNAMIC', 'MU_S', 'MU_C', 'EPS',
+           'BREAKAWAY_MEAN_V']
 """Numbers printed in Campbell, Crawford, Morris, for side-by-side comparison.
 
 Only printed values live here (as printed, with their equation numbers); every value

@@ -4,10 +4,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..constants import REPO_ROOT
 from ..physics.params import ConfigError, FrictionParams, PlantParams, check_keys, check_number, load_yaml
 from .lqr import CONTROL_WEIGHT, STATE_WEIGHT
 
-REPO_ROOT = Path(__file__).resolve().parents[4]
+__all__ = ['DEFAULT_CONFIG', 'DEFAULT_DATA', 'PaperConfig', 'load_paper_config']
+
 DEFAULT_CONFIG = REPO_ROOT / 'config' / 'paper.yaml'
 DEFAULT_DATA = REPO_ROOT.parent / 'shared' / 'data'
 

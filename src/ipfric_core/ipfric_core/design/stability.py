@@ -9,6 +9,8 @@ from scipy.optimize import brentq
 from ..physics.params import FrictionParams, PlantParams
 from .linearize import characteristic_coefficients
 
+__all__ = ['delta_thresholds']
+
 
 def routh_first_column(coeffs) -> np.ndarray:
     """First column of the Routh array of a polynomial [a_n, ..., a_0] (a_n > 0).

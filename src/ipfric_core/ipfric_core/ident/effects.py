@@ -22,6 +22,8 @@ from ..physics.params import FrictionParams
 from ..physics.plant import undeclared_forces
 from ..physics.rig import inputs_through
 
+__all__ = ['EFFECTS']
+
 
 @dataclass(frozen=True)
 class ParamSpec:

@@ -29,11 +29,14 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.signal import butter, sosfiltfilt
 
+from ..analysis.records import Record
 from ..physics.params import ConfigError
 from ..physics.plant import held_forces, pendulum_residuals, required_forces
 from . import effects as fx
-from .records import Record
 from .residual import signature_scores, whiteness
+
+__all__ = ['P_VALUE', 'BOOTSTRAP', 'balance', 'param_specs', 'errors', 'analyse', 'identify', 'identify_steady',
+           'model_vectors']
 
 MIN_GAIN_PERCENT = 1.0
 P_VALUE = 0.01

@@ -12,12 +12,14 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..analysis.records import Record, trajectory_record
 from ..constants import DURATION
 from ..physics.closedloop import Trajectory
 from ..physics.params import FrictionParams, PlantParams
 from ..physics.plant import CartPendulum
 from ..physics.rig import PlantTruth, Rig
-from .records import Record, trajectory_record
+
+__all__ = ['MULTISINE', 'multisine', 'cart_alone_run']
 
 #: (amplitude [V], frequency [Hz], phase [rad]) of the default multisine
 MULTISINE = ((1.2, 0.4, 0.0), (0.6, 1.1, 1.0), (0.35, 2.7, 2.0), (0.2, 5.3, 0.5))

@@ -41,13 +41,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..analysis.records import Record
 from ..physics.params import ConfigError
 from ..physics.rig import inputs_through
 from . import lsq, shooting
 from .effects import EFFECTS
 from .equation_error import BOOTSTRAP, P_VALUE
 from .model import LADDER_EFFECTS, Model
-from .records import Record
+
+__all__ = ['TYPICAL', 'Problem', 'Step', 'run_ladder']
 
 SIM_GAIN_PERCENT = 2.0
 MIN_DROP_COUNTS = 0.05   # and by at least this much RMS [counts] (rounding alone leaves 0.29 count)

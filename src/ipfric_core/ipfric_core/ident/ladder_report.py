@@ -17,6 +17,8 @@ from . import shooting  # noqa: E402
 from .ladder import TYPICAL, Problem, Step  # noqa: E402
 from .report import save_figure, write_report  # noqa: E402
 
+__all__ = ['correlation_lines', 'write_ladder_report']
+
 CORRELATED = 0.9     # pairs of fitted parameters correlated at least this much are reported
 CHI2_2D_95 = 5.991   # chi-square quantile of a 95 % joint region of two parameters
 

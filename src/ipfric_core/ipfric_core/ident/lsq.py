@@ -21,6 +21,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
+__all__ = ['solve', 'ROUGH_COSINE', 'rough', 'quadratic', 'scan_errors']
+
 FTOL = 1e-4          # a fit ends at a step that lowers the sum of squares by less than this share of it
 
 

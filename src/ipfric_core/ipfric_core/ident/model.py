@@ -21,6 +21,9 @@ from ..physics.plant import plant_vector
 from ..physics.rig import PlantTruth
 from .effects import EFFECTS
 
+__all__ = ['PLANT_KNOWN', 'FRICTION_FITTED', 'LADDER_EFFECTS', 'ModelVectors', 'Model', 'declared', 'read_declared',
+           'load_declared']
+
 
 @dataclass(frozen=True)
 class Param:
@@ -179,30 +182,38 @@ def declared(plant: PlantParams, friction: FrictionParams, pendulum: bool) -> Mo
     return Model(friction.model, tuple(params), (), friction.gamma, plant.g, fn, pendulum)
 
 
-def load_declared(path, law: str, pendulum: bool, plant: PlantParams | None = None) -> Model:
-    """The declared model from a file: a scenario (its sim_node plant and friction), a
-    paper-style file (plant, and friction named by law: the ``law`` entry), or a file with
-    only ``plant:`` (friction: the paper's ``law``). No file: ``plant`` (a bag's stored
-    scenario) or Table 1, and the paper's ``law`` (Table 3 for exponential)."""
+def read_declared(path, law: str) -> tuple[PlantParams | None, FrictionParams]:
+    """The declared plant and friction law of file ``path``, read once: a scenario (its sim_node plant
+    and friction), a paper-style file (plant, and friction named by law: the ``law`` entry), or a
+    file with only ``plant:`` (friction: the paper's ``law``, Table 2 for coulomb, Table 3 for
+    exponential). No file: no plant (the caller's: a bag's stored scenario, or Table 1) and the
+    paper's ``law``."""
     from ..design.paperconfig import DEFAULT_CONFIG
     from ..physics.params import check_keys, load_yaml
     if law not in LAW_PARAMS:
         raise ConfigError(f'--base: {law!r} is not a law the ladder fits; allowed: {", ".join(LAW_PARAMS)}')
     paper = {name: FrictionParams.from_dict(v, f'{DEFAULT_CONFIG}: friction.{name}')
              for name, v in load_yaml(DEFAULT_CONFIG)['friction'].items()}
-    friction = next(f for f in paper.values() if f.model == law)   # Table 2 for coulomb, Table 3 for exponential
-    if path is not None:
-        data = load_yaml(path)
-        if 'sim_node' in data:
-            from ..run.scenario import load_scenario
-            scn = load_scenario(path)
-            plant, friction = scn.plant, scn.friction
-        else:
-            check_keys(str(path), data, {'plant', 'friction', 'design'}, {'plant'})
-            plant = PlantParams.from_dict(data['plant'], f'{path}: plant')
-            fr = data.get('friction')
-            if isinstance(fr, dict) and 'model' in fr:
-                friction = FrictionParams.from_dict(fr, f'{path}: friction')
-            elif isinstance(fr, dict) and law in fr:
-                friction = FrictionParams.from_dict(fr[law], f'{path}: friction.{law}')
-    return declared(plant or PlantParams(), friction, pendulum)
+    friction = next(f for f in paper.values() if f.model == law)
+    if path is None:
+        return None, friction
+    data = load_yaml(path)
+    if 'sim_node' in data:
+        from ..run.scenario import load_scenario
+        scn = load_scenario(path)
+        return scn.plant, scn.friction
+    check_keys(str(path), data, {'plant', 'friction', 'design'}, {'plant'})
+    plant = PlantParams.from_dict(data['plant'], f'{path}: plant')
+    fr = data.get('friction')
+    if isinstance(fr, dict) and 'model' in fr:
+        friction = FrictionParams.from_dict(fr, f'{path}: friction')
+    elif isinstance(fr, dict) and law in fr:
+        friction = FrictionParams.from_dict(fr[law], f'{path}: friction.{law}')
+    return plant, friction
+
+
+def load_declared(path, law: str, pendulum: bool, plant: PlantParams | None = None) -> Model:
+    """The declared model of file ``path`` (:func:`read_declared`); without a plant there, ``plant``
+    (a bag's stored scenario) or Table 1."""
+    declared_plant, friction = read_declared(path, law)
+    return declared(declared_plant or plant or PlantParams(), friction, pendulum)

@@ -14,15 +14,17 @@ from pathlib import Path
 
 import yaml
 
-from ..analysis.sweep import classify_run
+from ..analysis.records import trajectory_record
 from ..design.lqr import design
 from ..physics.params import FrictionParams, PlantParams
 from ..physics.rig import PlantTruth
 from ..run.scenario import Scenario, load_scenario
+from ..study.outcome import classify_run
 from .ladder import run_ladder
 from .ladder_report import write_ladder_report
 from .model import load_declared
-from .records import trajectory_record
+
+__all__ = ['export_scenario', 'close_the_loop']
 
 
 def design_friction(friction: FrictionParams) -> FrictionParams:

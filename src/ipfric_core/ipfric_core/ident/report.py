@@ -15,6 +15,8 @@ from . import shooting  # noqa: E402
 from .equation_error import analyse, balance, errors, model_vectors, param_specs  # noqa: E402
 from .residual import SIGNATURES, time_since_reversal  # noqa: E402
 
+__all__ = ['save_figure', 'write_report']
+
 
 def friction_summary(params: dict, active, normal_force: float) -> dict:
     """The friction as the paper's coefficients: mu_c, mu_s (F_N = ``normal_force``), eps, ..."""
@@ -166,6 +168,7 @@ def write_report(res: dict, out: str | Path, plots: bool = True, result=None, fi
     out.mkdir(parents=True, exist_ok=True)
     r = (result or result_dict)(res)
     r['figures'] = (figs or figures)(res, out) if plots else []
+    r['files'] = {'report': str(out / 'report.md'), 'result': str(out / 'result.json')}
     (out / 'result.json').write_text(json.dumps(r, indent=2, default=float))
     (out / 'report.md').write_text((text or markdown)(r))
     return r

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+__all__ = ['whiteness', 'time_since_reversal', 'SIGNATURES', 'signature_scores']
+
 MAX_LAG = 25
 BINS = 20
 

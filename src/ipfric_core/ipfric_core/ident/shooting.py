@@ -25,11 +25,14 @@ import numba
 import numpy as np
 from scipy.signal import butter, sosfiltfilt
 
+from ..analysis.records import Record
 from ..physics.compiled import compiled
 from ..physics.plant import motor_force, motor_side_free
 from ..physics.rig import input_effects, inputs_through, play
 from ..physics.simulate import advance, advance_drive
-from .records import Record
+
+__all__ = ['rates', 'every', 'cart_windows', 'angle_windows', 'drive_states', 'delayed', 'predict', 'reading_errors',
+           'summary', 'window_sse']
 
 CART_WINDOW_S = 1.0
 PENDULUM_WINDOW_S = 0.25

@@ -13,7 +13,9 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Callable
 from dataclasses import replace
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +23,8 @@ import numpy as np
 from ..physics.params import ConfigError, FrictionParams, PlantParams
 from ..run.scenario import Scenario
 from .model import FRICTION_FITTED, PLANT_KNOWN, Model, declared
+
+__all__ = ['friction_cases', 'report_draws']
 
 
 def load_report(path: str | Path) -> tuple[Model, dict[str, float], float]:
@@ -78,3 +82,23 @@ def friction_shift(model: Model, std: dict[str, float], dt: float, base: Scenari
         raise ConfigError('--from-ident: the report gives no standard error for the friction law\'s '
                           f'parameters ({", ".join(FRICTION_FITTED)})')
     return report_scenario(model, std, dt, base, dict.fromkeys(names, float(k)))
+
+
+def friction_cases(path: str | Path, base: Scenario) -> tuple[list[tuple[str, float, Scenario]], str]:
+    """The friction cases of a design check from an identification: (label, standard errors, scenario) with
+    the friction at -1, 0 and +1 standard error (:func:`friction_shift`), and the axis they lie on."""
+    model, std, dt = load_report(path)
+    cases = [(f'friction {k:+d} SE' if k else 'identified', float(k), friction_shift(model, std, dt, base, k)[1])
+             for k in (-1, 0, 1)]
+    return cases, f'friction coefficients [standard errors of {path}]'
+
+
+def report_draws(path: str | Path, base: Scenario, seed: int) -> tuple[Callable[[int], tuple[dict, Scenario]], dict]:
+    """The Monte Carlo's draw of run i from an identification's parameter table (:func:`report_draw`),
+    and what is drawn (for the summary)."""
+    if seed < 0:
+        raise ConfigError(f'--seed: {seed} must be >= 0 (run i draws with the seed (seed, i))')
+    model, std, dt = load_report(path)
+    return (partial(report_draw, model, std, dt, base, seed),
+            {'from_ident': str(path), 'std': std,
+             'meaning': 'value ~ N(identified value, std^2), independent, clipped to the bounds'})

@@ -20,6 +20,8 @@ from pathlib import Path
 
 import numba
 
+__all__ = ['compiled']
+
 #: a cache of another source version that no import has used for this long is removed [s]
 STALE_AFTER_S = 86400.0
 

@@ -12,6 +12,8 @@ from dataclasses import dataclass
 
 from .compiled import compiled
 
+__all__ = ['delay_samples', 'filter_coefficient', 'filtered_rate', 'feedback', 'FeedbackSpec', 'StateFeedback']
+
 
 def delay_samples(tau: float, dt: float) -> int:
     """Number of samples n with tau = n dt; raises ValueError if tau is not a multiple."""

@@ -9,6 +9,8 @@ import numpy as np
 
 from .compiled import compiled
 
+__all__ = ['quantize']
+
 
 @compiled
 def quantize(value: float, resolution: float) -> float:

@@ -15,6 +15,9 @@ from typing import Any
 
 import yaml
 
+__all__ = ['FRICTION_MODELS', 'SMOOTHING', 'ConfigError', 'Field', 'check_number', 'check_choice', 'check_keys',
+           'PLANT_FIELDS', 'PlantParams', 'FRICTION_FIELDS', 'FrictionParams', 'load_yaml']
+
 FRICTION_MODELS = ('viscous', 'coulomb', 'exponential', 'dynamic')
 SMOOTHING = ('none', 'tanh')
 

@@ -21,6 +21,8 @@ from .params import FrictionParams
 from .plant import CartPendulum
 from .simulate import Simulator
 
+__all__ = ['PlantTruth', 'input_effects', 'inputs_through', 'play', 'sensor_reading', 'RigSpec', 'Rig']
+
 
 @dataclass(frozen=True)
 class PlantTruth:

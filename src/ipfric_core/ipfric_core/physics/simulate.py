@@ -37,6 +37,8 @@ from .plant import (
     undeclared_force,
 )
 
+__all__ = ['held', 'advance', 'advance_drive', 'friction_now', 'Simulator']
+
 MAX_EVENTS = 64  # per substep; a guard, never reached in normal motion
 XTOL = 1e-13     # event time tolerance [s]
 CONTACT_STEPS = 40       # steps per period of the drive's contact oscillation

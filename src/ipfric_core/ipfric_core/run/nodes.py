@@ -18,6 +18,8 @@ import yaml
 from ..physics.params import ConfigError, load_yaml
 from .scenario import load_scenario
 
+__all__ = ['NODES', 'OVERRIDES', 'parse_overrides', 'write_run_scenario', 'node_parameters', 'ros_args']
+
 #: The processes of a run in start order: name -> (package, executable).
 NODES = {
     'recorder': ('ipfric_record', 'recorder'),

@@ -37,18 +37,17 @@ import random
 import signal
 import socket
 import subprocess
-import sys
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import yaml
 
-from ..constants import LIMITS
+from ..constants import LIMITS, REPO_ROOT
 from ..physics.params import ConfigError
 from .nodes import NODES, node_parameters, ros_args, write_run_scenario
 
-ROOT = Path(os.environ.get('IPFRIC_ROOT') or Path(__file__).resolve().parents[4])
+__all__ = ['EXIT_FELL', 'SUPERVISED', 'die_with_parent', 'ros_environment', 'pick_domain', 'RunResult', 'Run', 'run']
 
 #: Exit codes of a run besides 0, 1 (a node failed), 2 (bad input) and 130 (Ctrl-C).
 EXIT_FAULT = 3    # a safety fault: watchdog, stall, refused commands, unexpected publisher
@@ -72,7 +71,7 @@ def die_with_parent(sig: int = signal.SIGTERM) -> None:
 
 def ros_environment(domain: int) -> dict:
     """The environment of scripts/env.sh plus the run's domain, DDS on loopback only."""
-    env_sh = ROOT / 'scripts' / 'env.sh'
+    env_sh = REPO_ROOT / 'scripts' / 'env.sh'
     out = subprocess.run(['bash', '-c', f'set -e; source "{env_sh}" >/dev/null; env -0'],
                          capture_output=True, check=True)
     env = dict(item.split('=', 1) for item in out.stdout.decode().split('\0') if '=' in item)
@@ -108,7 +107,7 @@ def pick_domain(rng: random.Random | None = None) -> int:
 
 def executable(name: str) -> Path:
     pkg, exe = NODES[name]
-    path = ROOT / 'ros2_ws' / 'install' / pkg / 'lib' / pkg / exe
+    path = REPO_ROOT / 'ros2_ws' / 'install' / pkg / 'lib' / pkg / exe
     if not path.exists():
         raise FileNotFoundError(f'{path} not found: build the workspace (bash scripts/setup.sh)')
     return path
@@ -438,33 +437,3 @@ def run(config, out, duration: float | None = None, **kwargs) -> RunResult:
     r = Run(config, out, duration, **kwargs)
     r.start()
     return r.wait()
-
-
-def cmd_run(args) -> int:
-    """``./ipfric run``: the command line front end (SIGINT and SIGTERM stop the run cleanly)."""
-    def to_interrupt(_signum, _frame):
-        raise KeyboardInterrupt
-    # explicit: a shell without job control starts background commands with SIGINT ignored
-    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):   # SIGHUP: the terminal closed
-        signal.signal(sig, to_interrupt)
-    r = Run(args.config, args.out, args.duration, domain=args.domain, timeout=args.timeout)
-    try:
-        r.start()
-    except KeyboardInterrupt:
-        r.kill()
-        return 130
-    except FileNotFoundError as exc:
-        print(f'ipfric run: {exc}', file=sys.stderr)
-        return 1
-    if not args.json:
-        print(f'ipfric run: {args.config} -> {args.out} (ROS domain {r.domain}, DDS on loopback); '
-              f'Ctrl-C stops the run and keeps the bag', file=sys.stderr)
-    res = r.wait()
-    if args.json:
-        json.dump(res.to_dict(), sys.stdout, indent=2)
-        sys.stdout.write('\n')
-    else:
-        print(res.summary())
-    for f in res.failures + res.faults:
-        print(f'ipfric run: {f}', file=sys.stderr)
-    return res.exit_code

@@ -43,7 +43,7 @@ from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 from typing import Any
 
-from ..constants import ANGLE_RESOLUTION_RAD, CART_RESOLUTION_M, FALLEN_ANGLE_RAD, TRACK_LIMIT_M
+from ..constants import ANGLE_RESOLUTION_RAD, CART_RESOLUTION_M, FALLEN_ANGLE_RAD, REPO_ROOT, TRACK_LIMIT_M
 from ..design.lqr import CONTROL_WEIGHT, STATE_WEIGHT, design
 from ..physics.controller import StateFeedback, delay_samples
 from ..physics.params import (
@@ -63,6 +63,10 @@ from ..physics.params import (
 from ..physics.plant import CartPendulum
 from ..physics.rig import PlantTruth, Rig
 
+__all__ = ['DEFAULT_SCENARIO', 'Scenario', 'nest', 'scenario_from_ros_params', 'load_scenario']
+
+#: the scenario ``./ipfric run`` and the other commands take when none is given
+DEFAULT_SCENARIO = REPO_ROOT / 'config' / 'default.yaml'
 TIME_MODES = ('lockstep', 'realtime')
 GAIN_SOURCES = ('yaml', 'design')
 

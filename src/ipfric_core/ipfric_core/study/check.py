@@ -21,24 +21,30 @@ moved by an identification's standard errors); for each:
   quantization alone makes the loop do. Defined only when that loop rests with exact sensors
   (else the delay or the gain, not quantization, keep it moving).
 
-Inputs are physics specs (:class:`CheckCase`); nothing here knows a scenario file.
+Each case is a :class:`CheckCase` of physics specs (:func:`case_of` makes one from a scenario);
+:func:`check_scenarios` checks a scenario against friction variants of it (:func:`friction_cases`).
 """
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import partial
 
 import numpy as np
 
+from ..design.critical_delay import gain_critical_delay
+from ..design.describing import friction_loop, predict_hunting
+from ..design.linearize import jacobian
 from ..physics.controller import FeedbackSpec
 from ..physics.params import FrictionParams, PlantParams
 from ..physics.rig import RigSpec
-from .critical_delay import gain_critical_delay
-from .describing import friction_loop, predict_hunting
-from .linearize import jacobian
+from ..run.scenario import Scenario
 from .orbit import LoopNumbers, OrbitError, find_orbit, loop_numbers, settle
+from .variants import exact_sensors, scenario_at
+
+__all__ = ['MAX_DELAY', 'linear_delays', 'friction_cases', 'check_scenarios']
 
 #: the loops of a case: exact sensors, the scenario's encoders, and on viscous-only friction exact sensors
 #: and the encoders
@@ -342,3 +348,39 @@ def design_check(nominal: CheckCase, others: Sequence[CheckCase], max_delay: flo
             'cutoff_hz': nominal.cutoff_hz, 'sensitivity': sensitivity(cases, i), 'verdict': verdict(cases, i),
             'definitions': {'hold_seconds': HOLD_SECONDS, 'cycles': CYCLES, 'scan_cycles': SCAN_CYCLES,
                             'growth': GROWTH, 'rest_m': REST_M}}
+
+
+def case_of(scn: Scenario, label: str, value: float) -> CheckCase:
+    """The check's view of scenario ``scn``: its physics and its loops (:data:`LOOPS`)."""
+    viscous = replace(scn, friction=scn.friction.replace(model='viscous', smoothing='none'))
+    rigs = {'exact': exact_sensors(scn), 'encoders': scn, 'viscous': exact_sensors(viscous), 'floor': viscous}
+    c = scn.controller
+    return CheckCase(label, value, scn.plant, scn.friction, tuple(scn.gain()), c.delay, c.cutoff_hz,
+                     {k: v.make_rig().loop_spec() for k, v in rigs.items()}, scn.make_controller().loop_spec())
+
+
+def friction_cases(base: Scenario, change: float = 0.3) -> tuple[list[tuple[str, float, Scenario]], str]:
+    """The friction cases of a check: (label, value, scenario) at friction x(1 - ``change``), the scenario,
+    x(1 + ``change``) (mu_s, mu_c and eps scaled), and the axis they lie on."""
+    if not (math.isfinite(change) and 0.0 < change < 1.0):
+        raise ValueError(f'--friction-change: {change!r} must be in (0, 1) (0.3 = friction x0.7 and x1.3)')
+    lo, hi = 1.0 - change, 1.0 + change
+    return ([(f'friction x{lo:g}', lo, scenario_at(base, 'friction', lo)), ('scenario', 1.0, base),
+             (f'friction x{hi:g}', hi, scenario_at(base, 'friction', hi))], 'friction scale (mu_s, mu_c, eps)')
+
+
+def check_scenarios(base: Scenario, scenarios: Sequence[tuple[str, float, Scenario]], axis: str,
+                    max_delay: float = MAX_DELAY, progress: Callable[[str], None] | None = None) -> dict:
+    """:func:`design_check` of the middle of ``scenarios`` (label, value, scenario: three, sorted by value)
+    against the other two, with the scenario's encoders and sample period."""
+    if not (math.isfinite(max_delay) and 0.0 < max_delay <= 1.0):
+        raise ValueError(f'--max-delay: {max_delay!r} s must be in (0, 1] s')
+    if max_delay <= base.controller.delay:
+        raise ValueError(f'--max-delay: {max_delay:g} s must exceed the scenario\'s delay '
+                         f'({base.controller.delay:g} s)')
+    t0 = time.perf_counter()
+    cases = [case_of(scn, label, value) for label, value, scn in scenarios]
+    res = design_check(cases[1], [cases[0], cases[2]], max_delay, progress)
+    res.update(axis=axis, encoders={'cart_m': base.sim.cart_resolution, 'angle_rad': base.sim.angle_resolution},
+               sample_period_s=base.sample_period, seconds=round(time.perf_counter() - t0, 1))
+    return res

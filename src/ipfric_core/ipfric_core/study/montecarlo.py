@@ -1,14 +1,14 @@
 """Monte Carlo over parameter uncertainty: the distribution of the hunting of a scenario.
 
 N runs of a scenario, each with its parameters drawn at random, each classified like a
-sweep cell (:func:`ipfric_core.analysis.sweep.classify_run`): class, cart and angle
+sweep cell (:func:`ipfric_core.study.outcome.classify_run`): class, cart and angle
 peak-to-peak [m, rad] and period [s] of the final regime. Draws come from
 :func:`spread_draw` (relative spreads on plant and friction coefficients) or from an
 identification's parameter table (:func:`ipfric_core.ident.uncertainty.report_draw`).
 
 Run i draws from its own generator, seeded by (seed, i): its parameters depend on the
 seed and i only, not on N or on where it runs, and its result only on its parameters, so
-the rows are the same in local processes and on a Dask cluster (:mod:`ipfric_core.executor`).
+the rows are the same in local processes and on a Dask cluster (:mod:`ipfric_core.study.executor`).
 """
 from __future__ import annotations
 
@@ -17,16 +17,22 @@ import json
 import math
 from collections.abc import Callable
 from dataclasses import replace
+from functools import partial
 from pathlib import Path
 from typing import Any
 
+import matplotlib.pyplot as plt
 import numpy as np
 
-from ..executor import make_executor
+from ..analysis.oscillation import CLASSES
+from ..analysis.plots import CLASS_COLOURS, save_figure
 from ..physics.params import FRICTION_FIELDS, PLANT_FIELDS, ConfigError, Field
 from ..run.scenario import Scenario
-from .oscillation import CLASSES
-from .sweep import classify_run, true_p2p
+from .executor import make_executor
+from .outcome import classify_run, true_p2p
+
+__all__ = ['DISTRIBUTIONS', 'parse_spread', 'spread_draw', 'run_chunk', 'run_montecarlo', 'spread_draws',
+           'montecarlo_study']
 
 #: how a relative spread s turns into a factor on the nominal value
 DISTRIBUTIONS = ('normal', 'uniform')   # 1 + s z with z ~ N(0, 1), or 1 + s u with u ~ U(-1, 1)
@@ -105,8 +111,8 @@ def run_chunk(chunk, duration: float) -> list[dict]:
 
 
 def run_montecarlo(draw: Callable[[int], tuple[dict, Scenario]], runs: int, duration: float,
-               workers: int | None = None, scheduler: str | None = None,
-               progress: Callable[[int, int], None] | None = None) -> list[dict]:
+                   workers: int | None = None, scheduler: str | None = None,
+                   progress: Callable[[int, int], None] | None = None) -> list[dict]:
     """``runs`` runs of ``duration`` [s], run i with the parameters ``draw(i)``; rows in run order.
 
     In local processes (``workers``, default all cores) or on the Dask cluster at ``scheduler``.
@@ -144,14 +150,63 @@ def summarize(rows: list[dict]) -> dict:
 def write_results(rows: list[dict], info: dict, out: str | Path, title: str) -> dict:
     """``out/runs.csv`` (one row per run), ``out/summary.json`` (``info`` and :func:`summarize`) and
     ``out/histogram.png``; returns the summary."""
-    from .plots import montecarlo_figure
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     with open(out / 'runs.csv', 'w', newline='') as fh:
         w = csv.DictWriter(fh, list(rows[0]))
         w.writeheader()
         w.writerows(rows)
-    summary = {**info, **summarize(rows), 'csv': str(out / 'runs.csv')}
-    summary['figure'] = str(montecarlo_figure(rows, HUNTING, title, out / 'histogram.png'))
+    summary = {**info, **summarize(rows), 'csv': str(out / 'runs.csv'), 'json': str(out / 'summary.json')}
+    summary['figure'] = str(montecarlo_figure(rows, title, out / 'histogram.png'))
     (out / 'summary.json').write_text(json.dumps(summary, indent=2, default=float))
     return summary
+
+
+def spread_draws(base: Scenario, text: str, seed: int, distribution: str = 'normal'
+                 ) -> tuple[Callable[[int], tuple[dict, Scenario]], dict]:
+    """The draw of run i from relative spreads ``text`` ('mu_s=0.3,mu_c=0.3'), and what is drawn (for the
+    summary)."""
+    if distribution not in DISTRIBUTIONS:
+        raise ConfigError(f'--distribution: {distribution!r} is not one of {", ".join(DISTRIBUTIONS)}')
+    if seed < 0:
+        raise ConfigError(f'--seed: {seed} must be >= 0 (run i draws with the seed (seed, i))')
+    spread = parse_spread(text)
+    meaning = ('value = nominal * (1 + s z), z ~ N(0, 1)' if distribution == 'normal' else
+               'value = nominal * (1 + s u), u ~ U(-1, 1)')
+    return (partial(spread_draw, base, spread, seed, distribution=distribution),
+            {'spread': spread, 'distribution': distribution, 'meaning': meaning})
+
+
+def montecarlo_study(draw: Callable[[int], tuple[dict, Scenario]], info: dict, runs: int, duration: float,
+                     out: str | Path, title: str, workers: int | None = None, scheduler: str | None = None,
+                     progress: Callable[[int, int], None] | None = None) -> dict:
+    """:func:`run_montecarlo` of ``runs`` draws, written by :func:`write_results` into ``out`` (``info``
+    heads the summary); returns the summary."""
+    if runs < 1:
+        raise ConfigError(f'--runs: {runs} must be >= 1')
+    if not (math.isfinite(duration) and duration > 0):
+        raise ConfigError(f'--duration: {duration!r} must be > 0 s')
+    if workers is not None and workers < 1:
+        raise ConfigError(f'--workers: {workers} must be >= 1')
+    rows = run_montecarlo(draw, runs, duration, workers, scheduler, progress)
+    return write_results(rows, {**info, 'runs': runs, 'duration_s': duration}, out, title)
+
+
+def montecarlo_figure(rows, title: str, path: str | Path) -> Path:
+    """Histograms of the cart and angle peak-to-peak and of the period over the hunting runs
+    (:data:`HUNTING`; the true motion), with the share of every class in the title."""
+    runs = [r for r in rows if r['class'] in HUNTING]
+    fig, axes = plt.subplots(1, 3, figsize=(13, 4))
+    for ax, (key, scale, label) in zip(axes, (('true_x_p2p_m', 100.0, 'cart p2p (cm)'),
+                                              ('true_theta_p2p_rad', 180.0 / math.pi, 'angle p2p (deg)'),
+                                              ('period_s', 1.0, 'period (s)'))):
+        v = [scale * r[key] for r in runs if r[key] is not None]
+        if v:
+            ax.hist(v, bins=min(40, max(5, len(v) // 10)), color='#fdae61', edgecolor='k', lw=0.3)
+            ax.axvline(float(np.median(v)), color='k', ls=':', label=f'median {np.median(v):.3g}')
+            ax.legend(fontsize=8)
+        ax.set(xlabel=label, ylabel='runs')
+    shares = ', '.join(f'{c.replace("_", " ")} {100 * sum(r["class"] == c for r in rows) / len(rows):.0f} %'
+                       for c in CLASS_COLOURS if any(r['class'] == c for r in rows))
+    fig.suptitle(f'{title}\n{len(rows)} runs: {shares}')
+    return save_figure(fig, path)

@@ -28,14 +28,12 @@ is counted in whole samples (about one sample of phase per sticking phase, two p
 cycle): abs 1e-3 of the period, about 5 samples.
 """
 import math
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 from independent import rigsim as rs
 
-from ipfric_core.design.orbit import find_orbit, loop_numbers
 from ipfric_core.physics.friction import (
     EXPONENTIAL,
     FP_ASYM,
@@ -50,6 +48,8 @@ from ipfric_core.physics.friction import (
     FP_V_S,
 )
 from ipfric_core.run.scenario import load_scenario
+from ipfric_core.study.orbit import find_orbit, loop_numbers
+from ipfric_core.study.variants import exact_sensors
 
 CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'fig7_old_gain_exponential.yaml'
 RIG = rs.RIGS['quanser']
@@ -61,12 +61,12 @@ REL = 1e-5                          # cycle agreement (see the module docstring)
 def scenario():
     """Figure 7 with exact sensors (as ``ipfric orbit --sensors exact``)."""
     scn = load_scenario(CONFIG)
-    return replace(scn, sim=replace(scn.sim, cart_resolution=0.0, angle_resolution=0.0))
+    return exact_sensors(scn)
 
 
 @pytest.fixture(scope='module')
 def loop(scenario):
-    """The sampled loop find_orbit solves (as the CLI's ``_orbit_loop`` at delay 0)."""
+    """The sampled loop find_orbit solves (as the CLI builds it with ``loop_of`` at delay 0)."""
     return loop_numbers(scenario.make_rig().loop_spec(), scenario.make_controller().loop_spec(), 0.0)
 
 

@@ -26,10 +26,10 @@ from dataclasses import replace
 
 import pytest
 
-from ipfric_core.analysis.sweep import threshold_angle
-from ipfric_core.cli import _orbit_loop, _sweep_base
-from ipfric_core.design.basin import LEAVES, SETTLES, basin_edge, fate, shape_threshold
-from ipfric_core.design.orbit import return_map
+from ipfric_core.study.basin import LEAVES, SETTLES, basin_edge, fate, shape_threshold
+from ipfric_core.study.orbit import return_map
+from ipfric_core.study.sweep import threshold_angle
+from ipfric_core.study.variants import load_variant, loop_of
 
 CASES = {
     'tanh': ('config/fig9_new_gain_exponential.yaml', 'tanh', 0.09),
@@ -39,8 +39,8 @@ CASES = {
 
 def loops(config, smoothing, delay, cutoff_hz=None):
     """theta0 [rad] -> the loop of ``config`` with exact sensors started there."""
-    base = _sweep_base(config, 'exact', smoothing, cutoff_hz)
-    return lambda theta0: _orbit_loop(base, 'theta0', theta0, delay)
+    base = load_variant(config, 'exact', smoothing, cutoff_hz)
+    return lambda theta0: loop_of(base, 'theta0', theta0, delay)
 
 
 @pytest.fixture(scope='module')
@@ -90,7 +90,7 @@ def test_the_run_at_the_edge_lingers_on_the_orbit(edges):
 def test_the_sweep_threshold_brackets_the_edge(edges):
     """`sweep --threshold` (its own classifier of 20 s windows) finds the same threshold."""
     config, smoothing, delay = CASES['tanh']
-    scn = _sweep_base(config, 'exact', smoothing)
+    scn = load_variant(config, 'exact', smoothing)
     base = replace(scn, controller=replace(scn.controller, delay=delay))
     res = threshold_angle(base, math.radians(0.05), math.radians(0.1), 40.0)
     edge = edges['tanh'][1]

@@ -26,6 +26,8 @@ import numpy as np
 
 from ..physics.params import ConfigError, PlantParams
 
+__all__ = ['Record', 'ANGLE_ZEROS', 'is_log', 'parse_columns', 'load', 'trajectory_record']
+
 MIN_SAMPLES = 200
 MAX_ROWS = 2_000_000    # a longer CSV is refused (33 min at 1 kHz; identification would take hours)
 MAX_VOLTAGE = 1e3       # |u| beyond this is not a drive command [V]
@@ -44,6 +46,7 @@ class Record:
     stick_velocity : |x'| [m/s] below which a sample counts as stuck (left out of the fit)
     valid : False where a reading is stale (a sample overrun); None = all valid
     notes : what loading found and did (overruns, resampling, angle mapping)
+    plant : the plant constants the record was read with (None for a force-input record)
     """
 
     name: str
@@ -59,6 +62,7 @@ class Record:
     cutoff_hz: float = 20.0
     valid: np.ndarray | None = None
     notes: tuple = field(default=())
+    plant: PlantParams | None = None
 
     @property
     def dt(self) -> float:
@@ -111,6 +115,27 @@ def overruns(t: np.ndarray, readings: list) -> np.ndarray:
 
 
 ANGLE_ZEROS = ('auto', 'upright', 'hanging')
+#: the record names a CSV's columns map to (``--columns NAME=HEADER``)
+COLUMNS = ('t', 'x', 'voltage', 'theta')
+#: suffixes of rig logs (a CSV table, a MATLAB file); anything else is a run bag
+LOG_SUFFIXES = ('.csv', '.mat')
+
+
+def is_log(path: str | Path) -> bool:
+    """True for a rig log (:data:`LOG_SUFFIXES`, a gzipped CSV too), False for a bag or run directory."""
+    name = Path(path).name.lower()
+    return Path(name).suffix in LOG_SUFFIXES or name.endswith('.csv.gz')
+
+
+def parse_columns(text: str | None) -> dict[str, str]:
+    """``t=time_s,x=cart_m,...`` as name -> CSV header (names of :data:`COLUMNS`)."""
+    columns = {}
+    for item in text.split(',') if text else []:
+        key, _, name = item.partition('=')
+        if not name or key.strip() not in COLUMNS:
+            raise ConfigError(f'--columns: {item!r} is not NAME=HEADER with NAME one of {", ".join(COLUMNS)}')
+        columns[key.strip()] = name.strip()
+    return columns
 
 
 def upright_angle(theta: np.ndarray, zero: str = 'auto') -> tuple[np.ndarray, list[str]]:
@@ -188,12 +213,24 @@ def check_record(rec: Record, angle_zero: str = 'auto') -> Record:
     return replace(rec, theta=theta, valid=valid, notes=tuple(notes))
 
 
-def _rig_record(name, t, x, u, theta, plant: PlantParams, angle_zero: str = 'auto') -> Record:
+def _rig_record(name, t, x, u, theta, plant: PlantParams, angle_zero: str = 'auto', notes=()) -> Record:
     pend = None if theta is None else (plant.m, plant.l, plant.g)
     fn = plant.normal_force if theta is not None else plant.M * plant.g
-    return check_record(Record(name, np.asarray(t, float), np.asarray(x, float), np.asarray(u, float),
-                               plant.alpha, plant.beta, None if theta is None else np.asarray(theta, float),
-                               pend, fn, stick_velocity=2e-3, cutoff_hz=25.0), angle_zero)
+    rec = check_record(Record(name, np.asarray(t, float), np.asarray(x, float), np.asarray(u, float),
+                              plant.alpha, plant.beta, None if theta is None else np.asarray(theta, float),
+                              pend, fn, stick_velocity=2e-3, cutoff_hz=25.0, plant=plant), angle_zero)
+    return replace(rec, notes=tuple(notes) + rec.notes)
+
+
+def pendulum_angle(theta, cart_alone: bool) -> tuple[np.ndarray | None, list[str]]:
+    """The angle column of a record as the pendulum gives it: None with ``cart_alone``, or when the
+    column holds one value throughout (a rig logs a constant, often 0, with its pendulum removed)."""
+    if theta is None or cart_alone:
+        return None, ['pendulum off (--cart-alone): its angle is not read'] if theta is not None else []
+    theta = np.asarray(theta, float)
+    if len(theta) and np.all(theta == theta[0]):
+        return None, [f'the angle column is {theta[0]:g} throughout: the pendulum is off (cart alone)']
+    return theta, []
 
 
 def _text_lines(path: Path):
@@ -214,19 +251,20 @@ def _text_lines(path: Path):
         stream.close()
 
 
-def load_csv(path: str | Path, plant: PlantParams, columns: dict | None = None, angle_zero: str = 'auto') -> Record:
+def load_csv(path: str | Path, plant: PlantParams, columns: dict | None = None, angle_zero: str = 'auto',
+             cart_alone: bool = False) -> Record:
     """CSV (or .csv.gz) with a header: t [s], x [m], voltage [V] and optionally theta [rad].
 
     ``columns`` maps these names to the file's headers, e.g. {'x': 'cart_m'}. Lines that
     start with '#' are comments. Read as a stream into typed arrays (memory about 8 bytes
-    a value); at most MAX_ROWS rows.
+    a value); at most MAX_ROWS rows. The angle is read as :func:`pendulum_angle` says.
     """
     path = Path(path)
-    cols = {'t': 't', 'x': 'x', 'voltage': 'voltage', 'theta': 'theta'}
+    cols = {n: n for n in COLUMNS}
     unknown = set(columns or {}) - set(cols)
     if unknown:
         raise ConfigError(f'column mapping: unknown name(s) {", ".join(sorted(unknown))}; '
-                          f'allowed: t, x, voltage, theta')
+                          f'allowed: {", ".join(COLUMNS)}')
     cols.update(columns or {})
     lines = ((i, ln) for i, ln in _text_lines(path) if ln.strip() and not ln.lstrip().startswith('#'))
     head = [ln for _, ln in zip(range(100), _text_lines(path))]
@@ -264,7 +302,8 @@ def load_csv(path: str | Path, plant: PlantParams, columns: dict | None = None, 
     if rows == 0:
         raise ConfigError(f'{path}: a header and no data rows; expected rows of {", ".join(header)}')
     arrays = {n: np.frombuffer(data[n], float) for n in names}
-    return _rig_record(path.name, arrays['t'], arrays['x'], arrays['voltage'], arrays.get('theta'), plant, angle_zero)
+    theta, notes = pendulum_angle(arrays.get('theta'), cart_alone)
+    return _rig_record(path.name, arrays['t'], arrays['x'], arrays['voltage'], theta, plant, angle_zero, notes)
 
 
 def load_bag(path: str | Path, plant: PlantParams | None = None, cart_alone: bool = False) -> Record:
@@ -274,7 +313,7 @@ def load_bag(path: str | Path, plant: PlantParams | None = None, cart_alone: boo
     [t_k, t_k+1). The plant constants come from ``plant`` or else the run's stored
     scenario (the design side: alpha, beta, masses; never the friction or the truth).
     """
-    from ..analysis.bagread import read_run
+    from .bagread import read_run
     run = read_run(path)
     if plant is None:
         if not run.config or 'plant' not in run.config:
@@ -286,8 +325,8 @@ def load_bag(path: str | Path, plant: PlantParams | None = None, cart_alone: boo
         raise ConfigError(f'{path}: only {int(ok.sum())} commands match an encoder sample; '
                           f'at least {MIN_SAMPLES} are needed')
     idx = k[ok]
-    return _rig_record(Path(path).name, run.t[idx], run.x[idx], run.voltage[ok],
-                       None if cart_alone else run.theta[idx], plant)
+    theta, notes = pendulum_angle(run.theta[idx], cart_alone)
+    return _rig_record(Path(path).name, run.t[idx], run.x[idx], run.voltage[ok], theta, plant, notes=notes)
 
 
 def load_emps(path: str | Path) -> Record:
@@ -318,7 +357,7 @@ def load(path: str | Path, plant: PlantParams | None, columns: dict | None = Non
     angle is measured from (:data:`ANGLE_ZEROS`)."""
     p = Path(path)
     if p.suffix.lower() == '.csv' or p.name.lower().endswith('.csv.gz'):
-        return load_csv(p, plant or PlantParams(), columns, angle_zero)
+        return load_csv(p, plant or PlantParams(), columns, angle_zero, cart_alone)
     if p.suffix.lower() == '.mat':
         return load_emps(p)
     if not p.exists():

@@ -6,7 +6,7 @@ With the delay tau = 0.090 s the upright is stable but its basin is small: start
 threshold theta0* and the pendulum falls above it. The run started at theta0* lingers for
 several seconds on an unstable periodic orbit (one Floquet multiplier 5.08 outside the unit
 circle): theta0* is where the start crosses that orbit's stable manifold. ipfric finds both
-with ``design.basin.basin_edge`` (bisection of theta0 with runs of its compiled loop, then
+with ``study.basin.basin_edge`` (bisection of theta0 with runs of its compiled loop, then
 Newton from the run at the edge); here the threshold and
 the lingering cycle also come from tests/independent/rigsim.py, written separately from the
 paper's equations and importing nothing from ipfric_core (its own RK4 at 0.1 ms substeps
@@ -66,11 +66,11 @@ import numpy as np
 import pytest
 from independent import rigsim as rs
 
-from ipfric_core.cli import _sweep_base
-from ipfric_core.design.basin import basin_edge
-from ipfric_core.design.orbit import loop_numbers
 from ipfric_core.physics import friction as fr
 from ipfric_core.physics.closedloop import LS_HISTORY
+from ipfric_core.study.basin import basin_edge
+from ipfric_core.study.orbit import loop_numbers
+from ipfric_core.study.variants import load_variant
 
 CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'fig9_new_gain_exponential.yaml'
 RIG = rs.RIGS['quanser']
@@ -90,7 +90,7 @@ SPEC = dict(rs.CASES['loop_none'], rig_overrides={'x_res': 0.0, 'theta_res': 0.0
 @pytest.fixture(scope='module')
 def base():
     """Figure 9 with exact sensors and tanh(100 v) (as ``ipfric sweep --sensors exact``)."""
-    return _sweep_base(CONFIG, 'exact', 'tanh')
+    return load_variant(CONFIG, 'exact', 'tanh')
 
 
 def _loop(base, theta0):

@@ -22,6 +22,8 @@ import numpy as np
 
 from .orbit import LoopNumbers, Orbit, OrbitError, return_map, shoot, shrunk
 
+__all__ = ['Edge', 'basin_edge', 'shape_threshold']
+
 #: a run has settled once its swing over a window is below this fraction of the first window's
 SETTLED = 1e-4
 #: a run has left once its swing over a window is this many times the first window's

@@ -6,11 +6,11 @@ from pathlib import Path
 
 import pytest
 
-from ipfric_core.analysis.montecarlo import parse_spread, run_montecarlo, spread_draw, summarize
 from ipfric_core.cli import main
 from ipfric_core.ident.uncertainty import load_report, report_draw
 from ipfric_core.physics.params import ConfigError
 from ipfric_core.run.scenario import load_scenario
+from ipfric_core.study.montecarlo import parse_spread, run_montecarlo, spread_draw, summarize
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -1,18 +1,18 @@
 """Runs on a Dask cluster give the rows of the local process pool; a dead scheduler is a clear error."""
 import socket
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from ipfric_core.analysis.montecarlo import run_montecarlo, spread_draw
-from ipfric_core.analysis.sweep import sweep
 from ipfric_core.cli import main
-from ipfric_core.executor import SchedulerError, make_executor
 from ipfric_core.run.scenario import load_scenario
+from ipfric_core.study.executor import SchedulerError, make_executor
+from ipfric_core.study.montecarlo import run_montecarlo, spread_draw
+from ipfric_core.study.sweep import sweep
+from ipfric_core.study.variants import exact_sensors
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope='module')
@@ -27,7 +27,7 @@ def cluster():
 @pytest.fixture(scope='module')
 def fig9_exact():
     s = load_scenario(ROOT / 'config' / 'fig9_new_gain_exponential.yaml')
-    return replace(s, sim=replace(s.sim, cart_resolution=0.0, angle_resolution=0.0))
+    return exact_sensors(s)
 
 
 def test_sweep_on_the_cluster_gives_the_local_rows(cluster, fig9_exact, tmp_path):
@@ -52,13 +52,13 @@ def test_montecarlo_on_the_cluster_gives_the_local_rows(cluster, tmp_path):
 
 def test_continuation_on_the_cluster_gives_the_local_branches(cluster):
     """The Jacobians' columns in tasks on the cluster: the same points, bit for bit."""
-    from ipfric_core.cli import _orbit_loop
-    from ipfric_core.design.continuation import trace
+    from ipfric_core.study.continuation import trace
+    from ipfric_core.study.variants import loop_of
     s = load_scenario(ROOT / 'config' / 'fig7_old_gain_exponential.yaml')
-    base = replace(s, sim=replace(s.sim, cart_resolution=0.0, angle_resolution=0.0))
+    base = exact_sensors(s)
 
     def run(executor):
-        found = trace(lambda v: _orbit_loop(base, 'delay', v), 0.0, 0.004, 4, probes=1, partners=False,
+        found = trace(lambda v: loop_of(base, 'delay', v), 0.0, 0.004, 4, probes=1, partners=False,
                       executor=executor)
         return found.jacobians, [(p.parameter, p.branch, p.orbit.x_p2p, p.orbit.period, tuple(p.orbit.multipliers))
                                  for p in found.points]

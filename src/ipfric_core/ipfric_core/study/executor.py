@@ -14,6 +14,8 @@ from __future__ import annotations
 import os
 from concurrent.futures import Executor, ProcessPoolExecutor
 
+__all__ = ['SchedulerError', 'make_executor']
+
 #: seconds to wait for the scheduler before giving up
 CONNECT_TIMEOUT_S = 5.0
 

@@ -5,8 +5,8 @@ import gzip
 import numpy as np
 import pytest
 
+from ipfric_core.analysis.records import load, overruns, upright_angle
 from ipfric_core.cli import main
-from ipfric_core.ident.records import load, overruns, upright_angle
 from ipfric_core.physics.params import ConfigError
 
 N = 600
@@ -38,7 +38,8 @@ REFUSED = [
     ('random .mat', 'rand.mat', bytes(np.random.default_rng(0).integers(0, 256, 4000, dtype=np.uint8)),
      'not a readable MATLAB file'),
     ('empty .mat', 'empty.mat', b'', 'not a readable MATLAB file'),
-    ('angle in degrees', 'deg.csv', table(theta=np.full(N, 15.0)), 'degrees?'),
+    ('angle in degrees', 'deg.csv', table(theta=15.0 + 5.0 * np.sin(np.arange(N) * 1e-2)), 'degrees?'),
+    # (a constant angle column is a removed pendulum: tests/analysis/test_records.py::test_constant_angle)
     ('no such file', 'missing.csv', None, 'cannot read'),
 ]
 
@@ -97,8 +98,22 @@ def test_the_angle_zero_can_be_named(tmp_path):
 
 
 def test_a_log_beyond_the_row_limit_is_refused_before_it_is_read(tmp_path, monkeypatch):
-    from ipfric_core.ident import records
+    from ipfric_core.analysis import records
     monkeypatch.setattr(records, 'MAX_ROWS', 200)
     (tmp_path / 'long.csv').write_text(table())          # 600 rows, over 1.5 times the limit
     with pytest.raises(ConfigError, match='at most 200 are read'):
         load(tmp_path / 'long.csv', None)
+
+
+def test_constant_angle_column_is_a_removed_pendulum(tmp_path):
+    """A rig logs a constant (often 0) in the angle column with its pendulum off: the record is a
+    cart-alone record, said in its notes; --cart-alone drops a moving angle too."""
+    (tmp_path / 'zero.csv').write_text(table(theta=np.zeros(N)))
+    rec = load(tmp_path / 'zero.csv', None)
+    assert rec.theta is None and rec.pendulum is None
+    assert any('pendulum is off' in n for n in rec.notes)
+    assert rec.normal_force == pytest.approx(rec.plant.M * rec.plant.g)
+    (tmp_path / 'swing.csv').write_text(table(theta=0.1 * np.sin(np.arange(N) * 1e-2)))
+    assert load(tmp_path / 'swing.csv', None).theta is not None
+    rec = load(tmp_path / 'swing.csv', None, cart_alone=True)
+    assert rec.theta is None and any('--cart-alone' in n for n in rec.notes)

@@ -8,16 +8,17 @@ from pathlib import Path
 import pytest
 
 from ipfric_core.cli import main
-from ipfric_core.design.check import settled_cycle
-from ipfric_core.design.orbit import find_orbit, loop_numbers
 from ipfric_core.run.scenario import load_scenario
+from ipfric_core.study.check import settled_cycle
+from ipfric_core.study.orbit import find_orbit, loop_numbers
+from ipfric_core.study.variants import exact_sensors
 
 ROOT = Path(__file__).resolve().parents[2]
 FIG7 = ROOT / 'config' / 'fig7_old_gain_exponential.yaml'
 
 
 def exact_loop(scn, delay=None):
-    scn = replace(scn, sim=replace(scn.sim, cart_resolution=0.0, angle_resolution=0.0))
+    scn = exact_sensors(scn)
     return loop_numbers(scn.make_rig().loop_spec(), scn.make_controller().loop_spec(), delay)
 
 

@@ -9,15 +9,15 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from ipfric_core.design.continuation import parse_continuation, trace, unstable_partners
-from ipfric_core.design.orbit import find_orbit, loop_numbers, return_map, simulated_cycle
 from ipfric_core.run.scenario import load_scenario
+from ipfric_core.study.continuation import parse_continuation, trace, unstable_partners
+from ipfric_core.study.orbit import find_orbit, loop_numbers, return_map, simulated_cycle
+from ipfric_core.study.variants import exact_sensors
 
 
 def exact(path, **controller):
     scn = load_scenario(path)
-    return replace(scn, sim=replace(scn.sim, cart_resolution=0.0, angle_resolution=0.0),
-                   controller=replace(scn.controller, **controller))
+    return replace(exact_sensors(scn), controller=replace(scn.controller, **controller))
 
 
 def loop_of(scn, delay=None):

@@ -1,75 +1,52 @@
-"""Stability maps over the artificial delay tau and the initial angle theta0 (Figures 11-12).
+"""Sweeps of a scenario's closed loop: stability maps over the artificial delay tau and the
+initial angle theta0 (Figures 11-12), the oscillation against encoder resolution (section 6)
+and the threshold angle between convergence and the periodic orbit (Figure 8b).
 
 Each cell is one closed-loop run of a scenario with the controller delay and theta0
-replaced, classified by :func:`ipfric_core.analysis.oscillation.classify`. Cells run in parallel
-processes (local, or on a Dask cluster: ``scheduler``, :mod:`ipfric_core.executor`), are appended
-to ``cells.csv`` as they finish (so an interrupted sweep resumes without redoing them), and are
-deterministic: a cell's result depends only on its inputs.
+replaced (:func:`ipfric_core.study.variants.cell_scenario`), classified by
+:func:`ipfric_core.study.outcome.classify_run`. Cells run in parallel processes (local, or on a
+Dask cluster: ``scheduler``, :mod:`ipfric_core.study.executor`), are appended to ``cells.csv``
+as they finish (so an interrupted sweep resumes without redoing them), and are deterministic:
+a cell's result depends only on its inputs. The ``*_study`` functions run a sweep and write its
+summary (JSON) and figure into an output directory.
 """
 from __future__ import annotations
 
 import csv
+import json
 import math
-import sys
+import shutil
 from collections.abc import Callable
 from concurrent.futures import as_completed
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+import yaml
 
-from ..constants import DURATION, LIMITS
-from ..executor import make_executor
-from ..physics.closedloop import run_closed_loop
+from ..analysis.bagread import read_run
+from ..analysis.oscillation import CLASSES
+from ..constants import LIMITS
+from ..physics.params import ConfigError
+from ..run.runner import EXIT_FELL, run
 from ..run.scenario import Scenario
-from .oscillation import CLASSES, classify
+from .executor import make_executor
+from .maps import resolution_figure, stability_map, transition_figure
+from .outcome import classify_run, classify_samples, true_p2p
+from .variants import (
+    FIGURE_GRIDS,
+    FIGURES,
+    SCALED_SENSORS,
+    cell_scenario,
+    figure_config,
+    load_variant,
+    scaled_encoders,
+    scenario_at,
+)
+
+__all__ = ['FIELDS', 'sweep', 'grid', 'boundaries', 'parse_range', 'resolution_study', 'threshold_angle',
+           'map_study', 'figure_study', 'resolution_report', 'threshold_report']
 
 FIELDS = ('tau_s', 'theta0_deg', 'class', 'transition_time_s', 'x_p2p_m', 'theta_p2p_rad', 'period_s')
-
-
-def cell_scenario(base: Scenario, tau: float, theta0_deg: float) -> Scenario:
-    """``base`` with the feedback delay tau [s] and initial angle theta0 [deg]."""
-    return replace(base, sim=replace(base.sim, theta0=math.radians(float(theta0_deg))),
-                   controller=replace(base.controller, delay=float(tau)))
-
-
-#: what a continuation or a diagram varies: the delay [s], a multiple of the gain, a multiple of
-#: the friction coefficients (mu_s, mu_c, eps)
-PARAMETERS = ('delay', 'gain', 'friction')
-
-
-def scenario_at(base: Scenario, name: str, value: float) -> Scenario:
-    """``base`` with parameter ``name`` (one of :data:`PARAMETERS`) at ``value``; a delay is
-    rounded to whole samples (what the controller applies)."""
-    if name == 'delay':
-        return replace(base, controller=replace(base.controller,
-                                                delay=round(value / base.sample_period) * base.sample_period))
-    if name == 'gain':
-        return replace(base, controller=replace(base.controller, gain=tuple(value * k for k in base.gain())))
-    if name == 'friction':
-        f = base.friction
-        return replace(base, friction=f.replace(mu_s=value * f.mu_s, mu_c=value * f.mu_c, eps=value * f.eps))
-    raise ValueError(f'parameter {name!r}: expected one of {", ".join(PARAMETERS)}')
-
-
-def classify_samples(scn: Scenario, t, x, theta, fell: bool, window: float = 10.0):
-    """:func:`classify` with the scenario's encoder counts and fallen angle."""
-    return classify(t, x, theta, (scn.sim.cart_resolution, scn.sim.angle_resolution), scn.sim.fallen_angle,
-                    ended_fallen=fell, window=window)
-
-
-def classify_run(scn: Scenario, duration: float, window: float = 10.0):
-    """Run ``scn`` offline for ``duration`` [s]; (its Oscillation from the measured positions, the Trajectory)."""
-    tr = run_closed_loop(scn.make_rig(), scn.make_controller(), duration)
-    return classify_samples(scn, tr.t, tr.measured[:, 0], tr.measured[:, 1], tr.end_reason != DURATION,
-                            window), tr
-
-
-def true_p2p(o, tr) -> tuple[float, float]:
-    """Peak-to-peak of the true cart position [m] and angle [rad] of the Trajectory ``tr`` over the
-    window its Oscillation ``o`` was judged on (the measured ones are in encoder counts)."""
-    w = tr.t >= tr.t[-1] - o.window[1] + o.window[0]
-    return float(np.ptp(tr.state[w, 0])), float(np.ptp(tr.state[w, 1]))
 
 
 def run_cell(base: Scenario, tau: float, theta0_deg: float, duration: float,
@@ -91,12 +68,6 @@ def run_cell(base: Scenario, tau: float, theta0_deg: float, duration: float,
 
 def _ros_cell(scn: Scenario, cell_dir: Path, duration: float):
     """(t, x, theta, ended by a limit) of one lockstep ROS run of ``scn``."""
-    import shutil
-
-    import yaml
-
-    from ..run.runner import EXIT_FELL, run
-    from .bagread import read_run
     if cell_dir.exists():          # a cell interrupted before it reached cells.csv: run it again
         shutil.rmtree(cell_dir)
     cell_dir.mkdir(parents=True)
@@ -141,7 +112,7 @@ def sweep(base: Scenario, taus, thetas_deg, duration: float, out_dir: str | Path
 
     ``ros``: each cell through the ROS 2 loop in lockstep (bags kept in ``out_dir/ros``;
     one cell at a time unless ``workers`` says otherwise, each cell being three processes).
-    ``scheduler``: the cells run on that Dask cluster (:func:`ipfric_core.executor.make_executor`).
+    ``scheduler``: the cells run on that Dask cluster (:func:`ipfric_core.study.executor.make_executor`).
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -211,22 +182,9 @@ def parse_range(text: str) -> np.ndarray:
                          f'or a comma-separated list of numbers') from exc
 
 
-def print_progress(done: int, total: int, label: str = 'cells') -> None:
-    sys.stderr.write(f'\r[sweep] {done}/{total} {label}')
-    if done == total:
-        sys.stderr.write('\n')
-    sys.stderr.flush()
-
-
-SENSORS = ('angle', 'cart', 'both')
-
-
 def resolution_cell(base: Scenario, scale: float, duration: float, sensor: str = 'angle') -> dict:
     """One run with the ``sensor`` encoder count(s) multiplied by ``scale`` (0 = exact)."""
-    s = base.sim
-    scn = replace(base, sim=replace(
-        s, cart_resolution=s.cart_resolution * (scale if sensor in ('cart', 'both') else 1.0),
-        angle_resolution=s.angle_resolution * (scale if sensor in ('angle', 'both') else 1.0)))
+    scn = scaled_encoders(base, scale, sensor)
     o, tr = classify_run(scn, duration)
     true_x, true_theta = true_p2p(o, tr)
     return {'scale': float(scale), 'cart_resolution_m': scn.sim.cart_resolution,
@@ -246,7 +204,7 @@ def resolution_study(base: Scenario, scales, duration: float, sensor: str = 'ang
 
 def angle_class(base: Scenario, theta0: float, duration: float, window: float):
     """The Oscillation of ``base`` run offline from the initial angle ``theta0`` [rad]."""
-    return classify_run(replace(base, sim=replace(base.sim, theta0=theta0)), duration, window)[0]
+    return classify_run(scenario_at(base, 'theta0', theta0), duration, window)[0]
 
 
 def threshold_angle(base: Scenario, lo: float, hi: float, duration: float, rtol: float = 0.01,
@@ -277,3 +235,107 @@ def threshold_angle(base: Scenario, lo: float, hi: float, duration: float, rtol:
                 progress(lo, hi)
     return {'settles_below_rad': lo, 'oscillates_from_rad': hi, 'runs': runs,
             'hi_class': c_hi.cls, 'hi_x_p2p_m': c_hi.x_p2p, 'hi_period_s': c_hi.period_crossings}
+
+
+def _write_json(out: Path, name: str, obj: dict) -> Path:
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / name
+    path.write_text(json.dumps(obj, indent=2, default=float))
+    return path
+
+
+def map_study(config, taus, thetas_deg, duration: float, out: str | Path, sensors: str = 'exact',
+              smoothing: str | None = None, cutoff_hz: float | None = None, workers: int | None = None,
+              progress: Callable[[int, int], None] | None = None, ros: bool = False,
+              scheduler: str | None = None) -> dict:
+    """The stability map of scenario file ``config`` (its :func:`~ipfric_core.study.variants.load_variant`)
+    over ``taus`` [s] and ``thetas_deg`` [deg]: ``out/cells.csv``, ``out/map.png``, ``out/summary.json``."""
+    base = load_variant(config, sensors, smoothing, cutoff_hz)
+    out = Path(out)
+    rows = sweep(base, taus, thetas_deg, duration, out, workers, progress, ros=ros, scheduler=scheduler)
+    title = f'{Path(config).stem}: {base.friction.model}' + (
+        f', tanh({base.friction.delta:g} v)' if base.friction.smoothing == 'tanh' else '')
+    fig = stability_map(taus, thetas_deg, grid(rows, taus, thetas_deg), title, out / 'map.png')
+    summary = {'config': str(config), 'sensors': sensors, 'duration_s': duration,
+               'path': 'ros lockstep' if ros else 'offline', 'cells': len(rows), 'figure': str(fig),
+               'csv': str(out / 'cells.csv'), 'counts': {c: sum(r['class'] == c for r in rows) for c in CLASSES},
+               'boundaries': boundaries(rows, taus, thetas_deg)}
+    _write_json(out, 'summary.json', summary)
+    return summary
+
+
+def figure_study(figure: str, taus, duration: float, out: str | Path, sensors: str = 'exact',
+                 cutoff_hz: float | None = None, workers: int | None = None,
+                 progress: Callable[[int, int], None] | None = None, say: Callable[[str], None] | None = None,
+                 ros: bool = False, scheduler: str | None = None) -> dict:
+    """The paper's Figure ``figure`` (a key of :data:`~ipfric_core.study.variants.FIGURES`): each variant
+    swept over the full and the zoomed theta0 grid, transition lines on the maps (``figureN.png``),
+    ``summary.json``."""
+    name, variants = FIGURES[figure]
+    config = figure_config(figure)
+    out = Path(out)
+    panels, result = [], {'figure_of_paper': figure, 'config': str(config), 'variants': {}}
+    for gname, trange in FIGURE_GRIDS:
+        ths = parse_range(trange)
+        panel: dict = {'title': f'θ0 {ths[0]:g}-{ths[-1]:g} deg', 'taus': taus, 'thetas_deg': ths, 'curves': []}
+        for label, smoothing, style in variants:
+            base = load_variant(config, sensors, smoothing, cutoff_hz)
+            d = out / f'{gname}_{smoothing or "model"}'
+            if say:
+                say(f'{label}, {gname} grid -> {d}')
+            rows = sweep(base, taus, ths, duration, d, workers, progress, ros=ros, scheduler=scheduler)
+            b = boundaries(rows, taus, ths)
+            panel.setdefault('classes', grid(rows, taus, ths))
+            panel['curves'].append((label, style, ths, [r['first_unsettled_tau_s'] for r in b],
+                                    [r['first_fallen_tau_s'] for r in b]))
+            result['variants'].setdefault(label, {})[gname] = {'csv': str(d / 'cells.csv'), 'boundaries': b}
+        panels.append(panel)
+    title = f'Figure {figure}: {name.removesuffix(".yaml")}, {sensors} sensors, {duration:g} s runs'
+    result['figure'] = str(transition_figure(panels, title, out / f'figure{figure}.png'))
+    _write_json(out, 'summary.json', result)
+    return result
+
+
+def resolution_report(config, scales_text: str, duration: float, out: str | Path, sensor: str = 'angle',
+                      smoothing: str | None = None, cutoff_hz: float | None = None, workers: int | None = None,
+                      scheduler: str | None = None) -> dict:
+    """:func:`resolution_study` of scenario file ``config`` at the scales ``scales_text`` (``parse_range``
+    syntax; 0 = exact, 1 = the scenario's counts): ``out/resolution.json`` and ``out/resolution.png``."""
+    try:
+        scales = parse_range(scales_text)
+    except ValueError as exc:
+        raise ConfigError(f'--resolution-scale: {exc}') from exc
+    if (scales < 0).any():
+        raise ConfigError('--resolution-scale: scales must be >= 0 (0 = exact sensors, 1 = the scenario\'s)')
+    if sensor not in SCALED_SENSORS:
+        raise ConfigError(f'--scale-sensor: {sensor!r} is not one of {", ".join(SCALED_SENSORS)}')
+    base = load_variant(config, 'config', smoothing, cutoff_hz)
+    rows = resolution_study(base, scales, duration, sensor, workers, scheduler)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    fig = resolution_figure(rows, f'{Path(config).stem}: oscillation against {sensor} encoder resolution',
+                            out / 'resolution.png')
+    summary = {'config': str(config), 'duration_s': duration, 'scaled': sensor, 'rows': rows, 'figure': str(fig)}
+    _write_json(out, 'resolution.json', summary)
+    return summary
+
+
+def threshold_report(config, bracket: str, duration: float, out: str | Path, sensors: str = 'exact',
+                     smoothing: str | None = None, cutoff_hz: float | None = None,
+                     progress: Callable[[float, float], None] | None = None, scheduler: str | None = None) -> dict:
+    """:func:`threshold_angle` of scenario file ``config`` in the bracket ``bracket`` ('LO,HI' [rad]):
+    ``out/threshold.json``."""
+    try:
+        lo, hi = (float(v) for v in bracket.split(','))
+    except ValueError as exc:
+        raise ConfigError(f'--threshold: {bracket!r}: expected LO,HI in rad, e.g. 1e-5,1e-3') from exc
+    if not (math.isfinite(lo) and math.isfinite(hi) and 0 <= lo < hi):
+        raise ConfigError(f'--threshold: need finite 0 <= LO < HI, got {lo:g}, {hi:g}')
+    base = load_variant(config, sensors, smoothing, cutoff_hz)
+    try:
+        res = threshold_angle(base, lo, hi, duration, progress=progress, scheduler=scheduler)
+    except ValueError as exc:
+        raise ConfigError(f'--threshold: {exc}') from exc
+    res.update(config=str(config), sensors=sensors, cutoff_hz=base.controller.cutoff_hz, duration_s=duration)
+    _write_json(Path(out), 'threshold.json', res)
+    return res

@@ -50,6 +50,8 @@ from .orbit import (
     shrunk,
 )
 
+__all__ = ['unstable_partners', 'trace', 'parse_continuation']
+
 #: relative amplitude difference under which two orbits are the same
 SAME = 0.02
 #: shrink factors of a stable orbit tried as starts for unstable ones

@@ -47,6 +47,10 @@ from ..physics.compiled import compiled
 from ..physics.controller import FeedbackSpec
 from ..physics.friction import DYNAMIC, FP_MODEL
 
+__all__ = ['LoopNumbers', 'loop_numbers', 'free_entries', 'entry_scale', 'return_map', 'motion', 'OrbitError',
+           'Orbit', 'shoot', 'bordered', 'return_map_jacobian', 'finish_orbit', 'settle', 'find_orbit', 'shrunk',
+           'resized', 'simulated_cycle']
+
 #: what a cycle can end with
 CYCLE_CODES = ('crossing', 'no_crossing', 'fallen', 'track_limit')
 #: columns of the return map's Jacobian in one task on an executor

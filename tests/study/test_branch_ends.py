@@ -21,15 +21,15 @@ import math
 import numpy as np
 import pytest
 
-from ipfric_core.cli import _orbit_loop, _sweep_base
-from ipfric_core.design.basin import basin_edge
-from ipfric_core.design.continuation import trace
-from ipfric_core.design.orbit import free_entries, passes_apart, return_map
+from ipfric_core.study.basin import basin_edge
+from ipfric_core.study.continuation import trace
+from ipfric_core.study.orbit import free_entries, passes_apart, return_map
+from ipfric_core.study.variants import load_variant, loop_of
 
 
 def test_the_large_cycle_ends_in_a_fold_beside_where_runs_fall():
-    base = _sweep_base('config/fig7_old_gain_exponential.yaml', 'exact', None)
-    found = trace(lambda v: _orbit_loop(base, 'delay', v), 0.078, 0.086, 20, probes=1, partners=False)
+    base = load_variant('config/fig7_old_gain_exponential.yaml', 'exact', None)
+    found = trace(lambda v: loop_of(base, 'delay', v), 0.078, 0.086, 20, probes=1, partners=False)
     folds = [e['parameter'] for e in found.events if e['event'] == 'fold']
     assert len(folds) == 1 and 0.0831 < folds[0] < 0.0835
     turn = [e for e in found.events if e['event'] == 'stability']
@@ -44,7 +44,7 @@ def sampled_critical_delay(base, lo: float, hi: float) -> float:
     """Delay [s] at which the largest complex eigenvalue of one sample of the loop at the
     upright (finite differences) reaches the unit circle, by bisection."""
     def radius(delay):
-        loop = _orbit_loop(base, 'theta0', 0.0, delay)
+        loop = loop_of(base, 'theta0', 0.0, delay)
         z = loop.start
         idx = free_entries(loop, len(z))
         ends, _ = passes_apart(loop, z, idx, np.full(len(idx), 1e-9), math.inf, 1, 0, 1)
@@ -58,9 +58,9 @@ def sampled_critical_delay(base, lo: float, hi: float) -> float:
 
 
 def test_the_edge_orbit_dies_at_the_sampled_loops_critical_delay():
-    base = _sweep_base('config/fig9_new_gain_exponential.yaml', 'exact', 'tanh')
-    edge = basin_edge(lambda a: _orbit_loop(base, 'theta0', a, 0.1), 1e-4, 0.03)
-    found = trace(lambda v: _orbit_loop(base, 'delay', v), 0.1, 0.11, 40, probes=1, partners=False,
+    base = load_variant('config/fig9_new_gain_exponential.yaml', 'exact', 'tanh')
+    edge = basin_edge(lambda a: loop_of(base, 'theta0', a, 0.1), 1e-4, 0.03)
+    found = trace(lambda v: loop_of(base, 'delay', v), 0.1, 0.11, 40, probes=1, partners=False,
                   orbits=[(0.1, edge.orbit)])
     dies = [e['parameter'] for e in found.events if e['event'] == 'dies']
     assert len(dies) == 1

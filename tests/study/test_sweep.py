@@ -1,12 +1,12 @@
 """Delay / initial-angle sweeps: classes, resume without redoing cells, determinism."""
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from ipfric_core.analysis.sweep import boundaries, grid, load_cells, parse_range, sweep
 from ipfric_core.run.scenario import load_scenario
+from ipfric_core.study.sweep import boundaries, grid, load_cells, parse_range, sweep
+from ipfric_core.study.variants import exact_sensors
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -14,7 +14,7 @@ ROOT = Path(__file__).resolve().parents[2]
 @pytest.fixture(scope='module')
 def fig9_exact():
     s = load_scenario(ROOT / 'config' / 'fig9_new_gain_exponential.yaml')
-    return replace(s, sim=replace(s.sim, cart_resolution=0.0, angle_resolution=0.0))
+    return exact_sensors(s)
 
 
 def test_small_map_has_the_three_regions(fig9_exact, tmp_path):
@@ -52,7 +52,7 @@ def test_scenario_writes_back_as_the_same_params_file(name, tmp_path):
     """A sweep cell's ROS parameter file loads back to the very scenario it was made from."""
     import yaml
 
-    from ipfric_core.analysis.sweep import cell_scenario
+    from ipfric_core.study.variants import cell_scenario
     scn = cell_scenario(load_scenario(ROOT / 'config' / name), np.float64(0.015), np.float64(2.5))
     path = tmp_path / 'cell.yaml'
     path.write_text(yaml.safe_dump(scn.to_ros_params()))

@@ -2,7 +2,7 @@
 overlaid on what simulations from the scenario's start do at the same parameters.
 
 Stable orbits are drawn solid, unstable dashed; each simulation is a marker coloured by its
-class (:func:`ipfric_core.analysis.oscillation.classify`) at its cart amplitude; for the
+class (:func:`ipfric_core.study.outcome.classify_run`) at its cart amplitude; for the
 delay, the linear critical delays tau_c (eq. 27, tanh-smoothed friction and sliding cart) are marked.
 """
 from __future__ import annotations
@@ -10,13 +10,15 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import matplotlib.pyplot as plt
 import numpy as np
 
-from ..design.check import linear_delays
-from .sweep import classify_run, scenario_at
+from ..analysis.plots import CLASS_COLOURS, save_figure
+from .check import linear_delays
+from .outcome import classify_run
+from .variants import scenario_at
 
-CLASS_COLOURS = {'settled': 'tab:green', 'limit_cycle': 'tab:blue', 'irregular': 'tab:orange',
-                 'growing': 'tab:red', 'fallen': 'black'}
+__all__ = ['diagram']
 
 
 def simulated_classes(base, name: str, values, duration: float = 20.0) -> list[dict]:
@@ -32,9 +34,6 @@ def simulated_classes(base, name: str, values, duration: float = 20.0) -> list[d
 def diagram(base, name: str, values, rows: list[dict], events: list[dict], path: str | Path,
             describing=None) -> Path:
     """Draw the diagram to ``path`` (PNG); ``describing``: optional rows (parameter, x_p2p_m)."""
-    import matplotlib
-    matplotlib.use('Agg')
-    import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(8, 4.8))
     for b in sorted({r['branch'] for r in rows}):
         pts = [r for r in rows if r['branch'] == b]
@@ -69,8 +68,4 @@ def diagram(base, name: str, values, rows: list[dict], events: list[dict], path:
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, loc='best')
     ax.set_title('periodic orbits of the sampled loop (lines) and simulations from the start (dots)', fontsize=9)
-    fig.tight_layout()
-    path = Path(path)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)

@@ -1,0 +1,56 @@
+"""``./ipfric run``: one closed-loop run of the ROS 2 nodes (simulator, controller, recorder) in a fresh
+ROS domain on loopback, recorded to a rosbag2 MCAP directory (:mod:`ipfric_core.run.runner`).
+
+SIGINT, SIGTERM and SIGHUP stop the run cleanly and keep the bag."""
+from __future__ import annotations
+
+import signal
+import sys
+
+from ..run.runner import Run
+from ..run.scenario import DEFAULT_SCENARIO
+from .output import print_json
+
+__all__ = ['NAME', 'HELP', 'add_arguments', 'main']
+
+NAME = 'run'
+HELP = ('closed-loop run of the ROS 2 nodes (simulator, controller, recorder) in a fresh ROS domain on loopback, '
+        'recorded to a rosbag2 MCAP directory')
+
+
+def add_arguments(r) -> None:
+    r.add_argument('--config', default=str(DEFAULT_SCENARIO),
+                   help='scenario parameter file (sim_node / controller_node sections; default %(default)s)')
+    r.add_argument('--duration', type=float, default=None,
+                   help='simulated seconds (default: the file\'s sim_node duration; 0 = until Ctrl-C)')
+    r.add_argument('--out', required=True, help='output directory: bag/, scenario.yaml, logs/, summary.json')
+    r.add_argument('--domain', type=int, default=None, help='ROS_DOMAIN_ID (default: a free one in 1..232)')
+    r.add_argument('--timeout', type=float, default=None, help='stop the run after this many wall seconds')
+
+
+def main(args) -> int:
+    def to_interrupt(_signum, _frame):
+        raise KeyboardInterrupt
+    # explicit: a shell without job control starts background commands with SIGINT ignored
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):   # SIGHUP: the terminal closed
+        signal.signal(sig, to_interrupt)
+    r = Run(args.config, args.out, args.duration, domain=args.domain, timeout=args.timeout)
+    try:
+        r.start()
+    except KeyboardInterrupt:
+        r.kill()
+        return 130
+    except FileNotFoundError as exc:
+        print(f'ipfric run: {exc}', file=sys.stderr)
+        return 1
+    if not args.json:
+        print(f'ipfric run: {args.config} -> {args.out} (ROS domain {r.domain}, DDS on loopback); '
+              f'Ctrl-C stops the run and keeps the bag', file=sys.stderr)
+    res = r.wait()
+    if args.json:
+        print_json(res.to_dict())
+    else:
+        print(res.summary())
+    for f in res.failures + res.faults:
+        print(f'ipfric run: {f}', file=sys.stderr)
+    return res.exit_code
