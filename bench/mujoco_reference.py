@@ -7,21 +7,20 @@ R = beta / alpha^2 its force K/R (V - K x') is the paper's eq. (2). The track fr
 the actuator's ``lugre`` friction (Coulomb mu_c F_N, static mu_s F_N, Stribeck velocity v_s,
 the Gaussian Stribeck curve, i.e. gamma = 2) plus the viscous eps as actuator ``damping``:
 sticking is approximated by a stiff bristle (``stiffness``, ``damping`` of the LuGre
-model), not exact. The controller is ipfric's (the same compiled scalar functions for
-encoder, velocity filter, delay and feedback) in a tight loop around ``mj_step`` at the
-sample rate, the plant stepping ``nstep`` Euler steps per sample.
+model), not exact. The controller is the offline loop's own step
+(``ipfric_core.physics.closedloop.controller_sample``: encoder, velocity filter, delay and
+feedback) in a tight loop around ``mj_step`` at the sample rate, the plant stepping ``nstep``
+Euler steps per sample.
 """
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import mujoco
 import numpy as np
 
-from ipfric_core.physics.closedloop import Trajectory
-from ipfric_core.physics.compiled import compiled
-from ipfric_core.physics.controller import feedback, filter_coefficient, filtered_rate
-from ipfric_core.physics.encoder import quantize
+from ipfric_core.physics.closedloop import LS_PLANT, Trajectory, controller_sample, loop_start
 
 MJCF = '''<mujoco model="ipfric cart-pendulum">
   <option timestep="{h}" gravity="0 0 -{g}" integrator="{integrator}"/>
@@ -55,20 +54,6 @@ def model_xml(scenario, h: float, sigma0: float, integrator: str = 'Euler') -> s
                        Fs=f.mu_s * fn, vs=f.v_s)
 
 
-@compiled
-def _control(k, q, meas, history, a, dt, resolution, gain, delay, vlimit):
-    """Encoder reading, velocity filter, delay and feedback of sample k (as StateFeedback)."""
-    mx, mth = quantize(q[0], resolution[0]), quantize(q[1], resolution[1])
-    vx = vth = 0.0
-    if k > 0:
-        vx = filtered_rate(a, history[k - 1, 2], meas[k - 1, 0], mx, dt)
-        vth = filtered_rate(a, history[k - 1, 3], meas[k - 1, 1], mth, dt)
-    meas[k, 0], meas[k, 1] = mx, mth
-    history[k, 0], history[k, 1], history[k, 2], history[k, 3] = mx, mth, vx, vth
-    j = max(k - delay, 0)
-    return feedback(gain, (history[j, 0], history[j, 1], history[j, 2], history[j, 3]), vlimit)
-
-
 class MujocoLoop:
     """A compiled MuJoCo model of a scenario, reusable for many runs."""
 
@@ -86,17 +71,21 @@ class MujocoLoop:
         d.qpos[1] = s.theta0 if theta0 is None else theta0
         dt = self.scenario.sample_period
         n = int(round(duration / dt)) + 1
-        meas, hist = np.empty((n, 2)), np.empty((n, 4))
-        state, volt = np.empty((n, 4)), np.empty(n)
-        args = (filter_coefficient(c.cutoff_hz, dt), dt, (float(s.cart_resolution), float(s.angle_resolution)),
-                tuple(float(g) for g in self.scenario.gain()),
-                int(round((c.delay if delay is None else delay) / dt)), float(c.voltage_limit))
+        meas, state, volt = np.empty((n, 2)), np.empty((n, 4)), np.empty(n)
+        # the controller of the offline loop (ipfric_core.physics.closedloop.controller_sample) on a loop
+        # state whose plant entries are MuJoCo's
+        scn = replace(self.scenario, sim=replace(s, theta0=float(d.qpos[1])))
+        if delay is not None:
+            scn = replace(scn, controller=replace(c, delay=delay))
+        rig, ctrl = scn.make_rig().loop_spec(), scn.make_controller().loop_spec()
+        z = loop_start(rig, ctrl)
         reason, k = 'duration', 0
         for k in range(n):
             q = d.qpos
             state[k, :2], state[k, 2:] = q, d.qvel
-            v = _control(k, q, meas, hist, *args)
-            volt[k] = v
+            z[LS_PLANT], z[LS_PLANT + 1] = q[0], q[1]
+            mx, mth, v = controller_sample(rig.resolution, rig.sensors, ctrl.gain, ctrl.control, z)
+            meas[k], volt[k] = (mx, mth), v
             if not (abs(q[1]) <= s.fallen_angle):
                 reason = 'FALLEN'
                 break

@@ -47,6 +47,7 @@ def ping(n: int) -> None:
     node = Node('bench_ping')
     pub = node.create_publisher(JointState, topics.JOINT_STATES, topics.data_qos())
     sub = node.create_subscription(VoltageCommand, topics.VOLTAGE_COMMAND, lambda m: None, topics.data_qos())
+    assert node.context.handle is not None
     ws = _rclpy.WaitSet(1, 0, 0, 0, 0, 0, node.context.handle)
     t0 = time.monotonic()
     while pub.get_subscription_count() < 1 or sub.get_publisher_count() < 1:

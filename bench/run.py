@@ -120,7 +120,7 @@ def bench_closed_loop(quick: bool) -> list[dict]:
 
 
 # ------------------------------------------------------------------------------------ sweep
-_MJ = {}
+_MJ: dict = {}   # the MuJoCo model of a process, built once
 
 
 def _mujoco_cell(args):
@@ -221,7 +221,7 @@ def _analyze(bag: Path) -> tuple[float, float, int]:
     cmd = [sys.executable, '-m', 'ipfric_core.cli', 'analyze', str(bag), '--no-plots', '--json']
     t0 = time.perf_counter()
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
-    out = proc.stdout.read()
+    out = proc.communicate()[0]
     _, status, usage = os.wait4(proc.pid, 0)
     wall = time.perf_counter() - t0
     if status != 0:
@@ -251,7 +251,7 @@ def bench_identify(quick: bool) -> list[dict]:
              ('identify on a 2-min 1 kHz closed-loop record (independent simulator, cogging)', None)]
     rows = []
     for name, args in cases:
-        row = {'benchmark': name, 'reference': '-', 'ratio': None, 'target': '< 60 s'}
+        row: dict = {'benchmark': name, 'reference': '-', 'ratio': None, 'target': '< 60 s'}
         if helped.returncode != 0:
             rows.append({**row, 'ipfric': 'not available (no identify command)', 'met': None})
             continue

@@ -84,7 +84,7 @@ def test_clean_data_gets_no_effect_and_the_declared_parameters(clean):
     fit, res = search(clean)
     assert fit.active == ('coulomb',), res['tried']
     p = fit.params
-    assert p['mass'] == pytest.approx(PLANT.M, rel=0.02)
+    assert p['M'] == pytest.approx(PLANT.M, rel=0.02)
     assert p['eps'] == pytest.approx(TRACK.eps, rel=0.03)
     assert p['Fc'] / FN == pytest.approx(TRACK.mu_c, rel=0.03)
     assert p['Fc'] + p['Fs_excess'] <= TRACK.mu_s * FN * 1.02  # stuck samples bound Fs from below only
@@ -105,7 +105,7 @@ def test_emps_beats_the_published_reference_models(data_dir, tmp_path):
     assert after['estimation']['relative_percent'] < 3.0   # published: 4.08 symmetric, 3.11 asymmetric
     assert after['validation']['relative_percent'] < 3.11
     assert after['validation']['rms'] < 0.5 * before['validation']['rms']
-    assert 94 < r['params']['mass']['value'] < 96
+    assert 94 < r['params']['M']['value'] < 96
     assert {t['name'] for t in r['effects_tried'] if not t['kept']} <= {'offset', 'presliding', 'stribeck'}
 
 

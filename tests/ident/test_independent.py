@@ -16,38 +16,39 @@ from independent import rigsim
 
 from ipfric_core.analysis.records import load
 from ipfric_core.cli import main
-from ipfric_core.ident.ladder import TYPICAL, run_ladder
+from ipfric_core.ident.effects import PARAMS
+from ipfric_core.ident.ladder import run_ladder
 from ipfric_core.ident.model import load_declared
 from ipfric_core.run.scenario import load_scenario
 
 
 def cogging_amplitude(p):
-    return math.hypot(p['cog_a'], p['cog_b'])
+    return math.hypot(p['cogging_sin_N'], p['cogging_cos_N'])
 
 
 # case, effects kept, {parameter: (true value, absolute tolerance)}
 CASES = [
     ('cart_none', (), {'Fc': (0.3425, 0.02), 'eps': (3.0, 0.2)}),
-    ('cart_deadzone', ('deadzone',), {'dz': (0.3, 0.03)}),
-    ('cart_cogging', ('cogging',), {'cog_period': (0.010, 0.0005), cogging_amplitude: (0.3, 0.05)}),
-    ('cart_asymmetry', ('asymmetry',), {'asym': (0.4, 0.05)}),
-    ('cart_delay', ('delay',), {'delay': (0.010, 0.003)}),
+    ('cart_deadzone', ('deadzone',), {'deadzone_V': (0.3, 0.03)}),
+    ('cart_cogging', ('cogging',), {'cogging_period_m': (0.010, 0.0005), cogging_amplitude: (0.3, 0.05)}),
+    ('cart_asymmetry', ('asymmetry',), {'asymmetry': (0.4, 0.05)}),
+    ('cart_delay', ('delay',), {'input_delay_s': (0.010, 0.003)}),
     ('loop_none', (), {}),
-    ('loop_deadzone', ('deadzone',), {'dz': (0.3, 0.06)}),
-    ('loop_cogging', ('cogging',), {'cog_period': (0.010, 0.001), cogging_amplitude: (0.3, 0.08)}),
-    ('loop_asymmetry', ('asymmetry',), {'asym': (0.4, 0.1)}),
-    ('loop_delay', ('delay',), {'delay': (0.010, 0.004)}),
-    ('loop_bias', ('sensor_bias',), {'theta_bias': (0.005, 0.002)}),
+    ('loop_deadzone', ('deadzone',), {'deadzone_V': (0.3, 0.06)}),
+    ('loop_cogging', ('cogging',), {'cogging_period_m': (0.010, 0.001), cogging_amplitude: (0.3, 0.08)}),
+    ('loop_asymmetry', ('asymmetry',), {'asymmetry': (0.4, 0.1)}),
+    ('loop_delay', ('delay',), {'input_delay_s': (0.010, 0.004)}),
+    ('loop_bias', ('sensor_bias',), {'bias_theta_rad': (0.005, 0.002)}),
     # drive play 1 mm, motor side 0.2 kg, contact 2e5 N/m (rigsim.EFFECTS['backlash']): the play within
     # two encoder counts (0.09 mm), the motor side within 10 %. The contact's stiffness and damping are
     # not compared: in the closed loop the simulated error is rough in every parameter (the contact
     # rings through many knocks: forward and backward differences disagree) and the fit stays at the
     # grid point it starts from (100 or 200 Hz, the two fit the estimation data equally well; which
     # one won used to depend on a race between threads); the report flags them (ROUGH below)
-    ('loop_backlash', ('drive_backlash',), {'drive_gap': (1e-3, 9e-5), 'drive_mass': (0.2, 0.02)}),
+    ('loop_backlash', ('drive_backlash',), {'drive_backlash_m': (1e-3, 9e-5), 'drive_mass_kg': (0.2, 0.02)}),
 ]
 #: parameters whose simulated error must be reported rough (their errors from a scan, not the Jacobian)
-ROUGH = {'loop_backlash': {'drive_stiffness', 'drive_damping'}}
+ROUGH = {'loop_backlash': {'drive_stiffness_N_per_m', 'drive_damping_Ns_per_m'}}
 
 
 @pytest.fixture(scope='module')
@@ -71,7 +72,7 @@ def test_undeclared_effect_in_independent_data(data, case, kept, expect):
     for key, (value, tol) in expect.items():
         got = key(final) if callable(key) else final[key]
         assert got == pytest.approx(value, abs=tol), key
-    assert not [p.name for p in final.params if p.at_bound(1e-3 * TYPICAL.get(p.name, 1.0))]
+    assert not [p.name for p in final.params if p.at_bound(1e-3 * PARAMS[p.name].typical)]
     assert ROUGH.get(case, set()) <= set(res['steps'][-1].std.rough)
     errors = [s.val['x_rms_counts'] for s in res['steps']]
     assert errors[-1] <= errors[1] * 1.02          # the ladder never ends worse than the refit
@@ -90,11 +91,12 @@ def test_drive_play_found_sized_and_exported(data, tmp_path, capsys):
     r = json.loads(capsys.readouterr().out)
     assert r['effects_added'] == ['drive_backlash'], r['effects_tried']
     final = {p['name']: p for p in r['ladder'][-1]['params']}
-    assert final['drive_gap']['value'] == pytest.approx(1e-3, abs=9e-5)
-    assert final['drive_mass']['value'] == pytest.approx(0.2, abs=0.02)
+    assert final['drive_backlash_m']['value'] == pytest.approx(1e-3, abs=9e-5)
+    assert final['drive_mass_kg']['value'] == pytest.approx(0.2, abs=0.02)
     # the contact's stiffness and damping: the truth within three standard errors (honest errors: the
     # Jacobian's in the scaled parameters, and a scan of the error where it is rough)
-    for name, truth in (('drive_stiffness', 2e5), ('drive_damping', 50.0), ('drive_gap', 1e-3), ('drive_mass', 0.2)):
+    for name, truth in (('drive_stiffness_N_per_m', 2e5), ('drive_damping_Ns_per_m', 50.0), ('drive_backlash_m', 1e-3),
+                        ('drive_mass_kg', 0.2)):
         assert abs(final[name]['value'] - truth) <= 3 * final[name]['std'], (name, final[name])
         assert final[name]['std'] < abs(truth), (name, final[name])     # and not merely unbounded
     assert final['Fc']['value'] == pytest.approx(0.3425, abs=0.02)
@@ -102,10 +104,10 @@ def test_drive_play_found_sized_and_exported(data, tmp_path, capsys):
     errors = [s['validation']['x_rms_counts'] for s in r['ladder']]
     assert errors[-1] < 0.1 * errors[1]          # 30 counts of coasting through the play explained
     truth = load_scenario(out).truth
-    assert truth.drive_backlash_m == pytest.approx(final['drive_gap']['value'])
-    assert truth.drive_mass_kg == pytest.approx(final['drive_mass']['value'])
-    assert truth.drive_stiffness_N_per_m == pytest.approx(final['drive_stiffness']['value'])
-    assert truth.drive_damping_Ns_per_m == pytest.approx(final['drive_damping']['value'])
+    assert truth.drive_backlash_m == pytest.approx(final['drive_backlash_m']['value'])
+    assert truth.drive_mass_kg == pytest.approx(final['drive_mass_kg']['value'])
+    assert truth.drive_stiffness_N_per_m == pytest.approx(final['drive_stiffness_N_per_m']['value'])
+    assert truth.drive_damping_Ns_per_m == pytest.approx(final['drive_damping_Ns_per_m']['value'])
 
 
 @pytest.mark.slow
@@ -157,4 +159,4 @@ def test_other_rig_with_overruns_and_5ms_sampling_stays_plausible(data, tmp_path
     assert 'sensor_bias' not in r['effects_added']
     assert not any(p['at_bound'] for p in r['ladder'][-1]['params'])
     dz = [t for t in r['effects_tried'] if t['effect'] == 'deadzone']
-    assert not dz or not dz[0]['kept'] or dz[0]['values']['dz'] < 0.5
+    assert not dz or not dz[0]['kept'] or dz[0]['values']['deadzone_V'] < 0.5

@@ -64,7 +64,7 @@ def test_delay_is_exact_in_samples():
 
 
 def test_controller_rejects_z_gain_and_saturates():
-    with pytest.raises(ValueError, match='gain\\[4\\]'):
+    with pytest.raises(ValueError, match='entry 4'):
         StateFeedback([1, 2, 3, 4, 5], 1e-3)
     c = StateFeedback([100.0, 0, 0, 0], 1e-3, voltage_limit=5.0)
     assert c.update(1.0, 0.0) == 5.0

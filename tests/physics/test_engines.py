@@ -17,8 +17,9 @@ sys.path.insert(0, str(ROOT))
 from bench.scipy_reference import run_scipy  # noqa: E402
 
 FIELDS = ('t', 'state', 'measured', 'voltage', 'friction', 'stuck')
-EFFECTS = PlantTruth(cogging_N=0.1, cogging_period_m=0.02, deadzone_V=0.1, saturation_V=8.0,
-                     input_delay_s=0.002, asymmetry=0.1, offset_N=0.02, cogging_phase_rad=0.5, backlash_m=1e-4,
+EFFECTS = PlantTruth(cogging_sin_N=0.0877583, cogging_cos_N=0.0479426, cogging_period_m=0.02, deadzone_V=0.1,
+                     saturation_V=8.0,
+                     input_delay_s=0.002, asymmetry=0.1, offset_N=0.02, backlash_m=1e-4,
                      bias_x_m=1e-3,
                      bias_theta_rad=1e-3)
 

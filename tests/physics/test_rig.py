@@ -37,12 +37,12 @@ def test_input_delay_shifts_the_applied_voltage():
 
 def test_cogging_force_moves_a_resting_cart():
     """0.95 N of cogging at x = P/4 exceeds mu_s F_N = 0.865 N: the cart breaks away unpowered."""
-    r = Rig(CartPendulum(PlantParams(), EXP), PlantTruth(cogging_N=0.95, cogging_period_m=0.02),
+    r = Rig(CartPendulum(PlantParams(), EXP), PlantTruth(cogging_sin_N=0.95, cogging_period_m=0.02),
             [0.005, math.pi, 0.0, 0.0], 1e-3, fallen_angle=4.0)
     for _ in range(50):
         r.step(0.0)
     assert r.truth()['x'] > 0.005
-    still = rig(PlantTruth(cogging_N=0.5, cogging_period_m=0.02))
+    still = rig(PlantTruth(cogging_sin_N=0.5, cogging_period_m=0.02))
     for _ in range(50):
         still.step(0.0)
     assert still.truth()['x'] == 0.0 and still.truth()['stuck']
@@ -120,9 +120,9 @@ def test_scenario_round_trip_and_design_source():
     ({**SIM, 'friction': {'model': 'magic'}}, CTRL, "friction.model: 'magic' is not one of viscous"),
     ({**SIM, 'plant_truth': {'cogging': 1.0}}, CTRL, 'plant_truth: unknown field(s) cogging'),
     ({**SIM, 'plant_truth': {'input_delay_s': 0.0015}}, CTRL, 'input_delay_s'),
-    (SIM, {'gain': [1, 2, 3]}, 'gain: expected 4 numbers'),
-    (SIM, {'gain': [1, 2, 3, 4, 5]}, 'gain[4]: the bristle state z is not measured'),
-    (SIM, {'gain': [1, 2, 3, float('inf')]}, 'gain[3]: inf is not finite'),
+    (SIM, {'gain': [1, 2, 3]}, 'gain: expected 4 finite numbers'),
+    (SIM, {'gain': [1, 2, 3, 4, 5]}, 'gain: entry 4 (the bristle state z) must be 0'),
+    (SIM, {'gain': [1, 2, 3, float('inf')]}, 'gain: expected 4 finite numbers'),
     (SIM, {**CTRL, 'delay': 0.0105}, 'delay: delay tau = 0.0105 s is not a multiple'),
     (SIM, {'gain_source': 'design'}, 'design_friction: missing'),
 ])

@@ -190,7 +190,7 @@ def test_both_sides_describe_the_same_loop(base, rig_edge):
         (RIG['eps'], RIG['mu_s'], RIG['mu_c'], RIG['v_s']), rel=1e-15)
     assert f[fr.FP_FN] == pytest.approx((M + m) * g, rel=1e-14)
     assert f[fr.FP_ASYM] == f[fr.FP_ASYM_V] == 0.0
-    assert loop.extra_force[0] == loop.extra_force[3] == 0.0            # no cogging, no offset force
+    assert loop.extra_force[0] == loop.extra_force[1] == loop.extra_force[3] == 0.0   # no cogging, no offset
     assert loop.gain == GAIN
     a, dt, delay, vlimit = loop.control
     assert loop.dt == dt == RIG['Ts']

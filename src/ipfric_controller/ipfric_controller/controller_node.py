@@ -31,12 +31,12 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 
 from ipfric_core.physics.closedloop import warm_up
-from ipfric_core.physics.controller import delay_samples
+from ipfric_core.physics.controller import delay_samples, gain_vector
 from ipfric_core.physics.params import ConfigError
 from ipfric_core.run.scenario import Scenario
 from ipfric_msgs.msg import VoltageCommand
 from ipfric_ros import topics
-from ipfric_ros.parameters import check_unknown, declare, declare_scenario, finite, plain
+from ipfric_ros.parameters import check_unknown, declare, declare_scenario, plain
 from ipfric_ros.signals import node_process
 
 #: Parameters that may change while the controller runs.
@@ -118,10 +118,10 @@ class ControllerNode(Node):
                 except ValueError as exc:
                     return SetParametersResult(successful=False, reason=f'delay: {exc}')
             elif p.name == 'gain':
-                if not isinstance(value, list) or len(value) != 4 or not finite(value):
-                    return SetParametersResult(
-                        successful=False,
-                        reason=f"gain: expected 4 finite numbers (x, theta, x', theta'), got {value!r}")
+                try:
+                    gain_vector(value)
+                except ValueError as exc:
+                    return SetParametersResult(successful=False, reason=f'gain: {exc}')
             elif p.name == 'cutoff_hz' and not (math.isfinite(value) and value >= 0.0):
                 return SetParametersResult(successful=False, reason=f'cutoff_hz: {value!r} must be >= 0')
             elif p.name == 'voltage_limit' and not (value > 0.0):
@@ -134,7 +134,7 @@ class ControllerNode(Node):
             if p.name == 'delay':
                 self.controller.set_delay(value)
             elif p.name == 'gain':
-                self.controller.gain = tuple(float(k) for k in value)
+                self.controller.gain = gain_vector(value)
                 if self.ready:
                     self._publish_gain()
             elif p.name == 'cutoff_hz':

@@ -74,8 +74,8 @@ class BagWriter:
         self._mcap.start(profile='ros2', library='ipfric_record (mcap python)')
         self._schemas: dict[str, int] = {}
         self.topics: dict[str, dict] = {}   # topic -> {id, type, qos, count, hash}
-        self.start_ns = None
-        self.end_ns = None
+        self.start_ns: int | None = None
+        self.end_ns: int | None = None
         self.closed = False
 
     def add_topic(self, topic: str, msgtype: str, qos: dict) -> int:

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import array
 import difflib
-import math
 
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor, ParameterType
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException, ParameterException
@@ -115,7 +114,3 @@ def declare_scenario(node, section: str, read_only=True) -> Scenario:
     if section == 'sim_node':
         return scenario_from_ros_params(nested, None)
     return scenario_from_ros_params(None, nested)
-
-
-def finite(values) -> bool:
-    return all(isinstance(v, (int, float)) and math.isfinite(v) for v in values)

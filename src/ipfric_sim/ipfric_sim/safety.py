@@ -47,10 +47,10 @@ class Refusals:
 
     def __init__(self, every_s: float = REPORT_EVERY_S):
         self.every_s = every_s
-        self.total = Counter()      # kind -> commands refused in the whole run
-        self.pending = Counter()    # kind -> refused since the last report
-        self.since = None           # sample of the first pending refusal
-        self.reported_at = None     # wall time of the last report [s]
+        self.total: Counter[str] = Counter()      # kind -> commands refused in the whole run
+        self.pending: Counter[str] = Counter()    # kind -> refused since the last report
+        self.since: int | None = None             # sample of the first pending refusal
+        self.reported_at: float | None = None     # wall time of the last report [s]
 
     def note(self, kind: str, detail: str, k: int, now: float) -> str | None:
         """Count one refusal at sample ``k``, wall time ``now`` [s]; a report for the first of a burst."""
@@ -65,7 +65,7 @@ class Refusals:
 
     def report(self, now: float, force: bool = False) -> str | None:
         """The summary of the refusals pending, when due (``force``: at the end of the run)."""
-        if not self.pending or not force and now - self.reported_at < self.every_s:
+        if not self.pending or not force and self.reported_at is not None and now - self.reported_at < self.every_s:
             return None
         n = sum(self.pending.values())
         detail = (f'{n} more command(s) refused since sample {self.since}: '
@@ -112,7 +112,7 @@ class CommandGuard:
 
         Returns (voltage, events) with events as (code, detail) pairs.
         """
-        events = []
+        events: list[tuple[str, str]] = []
         if command is None:
             self.missing += 1
             self.missed += 1

@@ -104,10 +104,10 @@ class SimNode(Node):
             VoltageCommand, topics.VOLTAGE_COMMAND, lambda msg, info: self._on_command(msg, publisher_gid(info)), qos)
         self.sub_gain = self.create_subscription(Float64MultiArray, topics.CONTROLLER_GAIN,
                                                  self._on_gain, topics.latched_qos())
-        self.published = Counter()
-        self.gain = None
-        self.controller_gid = None  # the publisher GID commands are accepted from
-        self.intruders = {}         # topic -> publishers seen beyond the expected one
+        self.published: Counter[str] = Counter()
+        self.gain: list[float] | None = None
+        self.controller_gid: bytes | None = None  # the publisher GID commands are accepted from
+        self.intruders: dict[str, int] = {}       # topic -> publishers seen beyond the expected one
         self.stalls = 0
         self._stalled = False
         self._last_valid = time.monotonic()

@@ -26,6 +26,7 @@ from ..physics.params import ConfigError
 from .bagread import RunData, read_run
 from .oscillation import balanced_segments, classify, regimes
 from .plots import overlay_figure, run_figure
+from .records import load, smallest_step
 
 __all__ = ['analyze_run', 'overlay_runs', 'analyze_log']
 
@@ -124,13 +125,6 @@ def overlay_runs(paths, plot_path: str | Path) -> dict:
                                            for p, s in zip(paths, shifts)]}
 
 
-def count_size(y) -> float:
-    """The smallest step of a sampled signal: its encoder count when it is quantized."""
-    d = np.abs(np.diff(np.asarray(y, float)))
-    d = d[d > 0]
-    return float(d.min()) if len(d) else 0.0
-
-
 def analyze_log(path: str | Path, columns: dict | None = None, angle_zero: str = 'auto',
                 max_angle: float = math.radians(20.0), min_duration: float = 2.0,
                 plot_dir: str | Path | None = None) -> dict:
@@ -138,14 +132,13 @@ def analyze_log(path: str | Path, columns: dict | None = None, angle_zero: str =
     maps names to headers) cut into balanced stretches (|theta| < ``max_angle`` [rad] for
     at least ``min_duration`` [s]), each into regimes: class, time span, cart and angle
     peak-to-peak, period by zero crossings and by spectrum, sticking."""
-    from .records import load
     rec = load(path, None, columns, angle_zero=angle_zero)
     if rec.theta is None:
         raise ConfigError(f'{path}: no pendulum angle in the file; analyze needs t, x and theta '
                           f'(map a CSV column with --columns theta=NAME)')
     theta = rec.theta
     zero = 'hanging' if any('hanging' in n for n in rec.notes) else 'upright'
-    resolution = (count_size(rec.x), count_size(theta))
+    resolution = (smallest_step(rec.x, 0.0), smallest_step(theta, 0.0))
     segments = []
     for a, b in balanced_segments(rec.t, theta, max_angle, min_duration):
         parts = regimes(rec.t[a:b], rec.x[a:b], theta[a:b], resolution)

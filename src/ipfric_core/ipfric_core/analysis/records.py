@@ -26,7 +26,7 @@ import numpy as np
 
 from ..physics.params import ConfigError, PlantParams
 
-__all__ = ['Record', 'ANGLE_ZEROS', 'is_log', 'parse_columns', 'load', 'trajectory_record']
+__all__ = ['Record', 'smallest_step', 'ANGLE_ZEROS', 'is_log', 'parse_columns', 'load', 'trajectory_record']
 
 MIN_SAMPLES = 200
 MAX_ROWS = 2_000_000    # a longer CSV is refused (33 min at 1 kHz; identification would take hours)
@@ -93,11 +93,13 @@ class Record:
         return parts[0], parts[1]
 
 
-def smallest_step(y: np.ndarray) -> float:
-    """The smallest nonzero step of a sampled signal (an encoder's count), 1.0 if it never moves."""
+def smallest_step(y, still: float = 1.0) -> float:
+    """The smallest nonzero step of a sampled signal: its encoder's count when it is quantized
+    (steps below 1e-12 of its size are rounding); ``still`` if it never moves."""
+    y = np.asarray(y, float)
     steps = np.abs(np.diff(y))
-    steps = steps[steps > 1e-12 * max(1.0, float(np.max(np.abs(y))))]
-    return float(steps.min()) if len(steps) else 1.0
+    steps = steps[steps > 1e-12 * max(1.0, float(np.max(np.abs(y))))] if len(y) else steps
+    return float(steps.min()) if len(steps) else still
 
 
 def overruns(t: np.ndarray, readings: list) -> np.ndarray:

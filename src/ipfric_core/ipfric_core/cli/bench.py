@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 from ..constants import REPO_ROOT
 from .output import print_json
@@ -27,7 +28,7 @@ def add_arguments(b) -> None:
 def main(args) -> int:
     sys.path.insert(0, str(REPO_ROOT))      # bench/ is part of the checkout, not of the package
     from bench.run import run_all
-    results = args.results or (QUICK_RESULTS if args.quick else RESULTS)
+    results = Path(args.results) if args.results else (QUICK_RESULTS if args.quick else RESULTS)
     out = run_all(args.quick, args.realtime_duration, results, progress=(lambda msg: print(msg, file=sys.stderr)))
     if args.json:
         print_json(out)

@@ -17,28 +17,62 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..physics.friction import DYNAMIC, bristle_path, friction_forces, friction_vector
-from ..physics.params import FrictionParams
+from ..physics.friction import DYNAMIC, FP_ASYM, bristle_path, friction_forces, friction_vector, static_limit
+from ..physics.params import FRICTION_FIELDS, PLANT_FIELDS, FrictionParams
 from ..physics.plant import undeclared_forces
-from ..physics.rig import inputs_through
+from ..physics.rig import PLANT_TRUTH_FIELDS, delayed_means, inputs_through
 
-__all__ = ['EFFECTS']
+__all__ = ['ParamSpec', 'PARAMS', 'Effect', 'BASE_PARAMS', 'EFFECTS', 'BASE_MODELS', 'effective_input', 'plateaus',
+           'dwell_profile', 'fitted_friction_vector', 'static_levels', 'position_force', 'resisting_force']
 
 
 @dataclass(frozen=True)
 class ParamSpec:
-    """One parameter: unit, bounds and start value (``None`` = chosen from the data)."""
+    """One quantity identification fits: unit, bounds, typical size (the fit works on value / size),
+    what it is."""
 
     name: str
     unit: str
     lo: float
     hi: float
-    init: float | None = 0.0
+    typical: float
+    doc: str
+
+
+#: fields whose 0 means "off" and that a fitted effect needs above 0: a saturation level, the motor side
+#: and the contact of a drive with play (the scenario's check: > 0 with a drive play)
+POSITIVE = ('saturation_V', 'drive_mass_kg', 'drive_stiffness_N_per_m')
+
+
+def _schema(table: dict, name: str, typical: float) -> ParamSpec:
+    """The schema's field ``name`` as a fitted parameter; an open lower bound (a period, a mass) or a field of
+    :data:`POSITIVE` starts at 1e-3 of the typical size, the smallest value the fit may try."""
+    f = table[name]
+    lo = 1e-3 * typical if f.lo_open or name in POSITIVE else float(f.lo)
+    return ParamSpec(name, f.unit, lo, float(f.hi), typical, f.doc)
+
+
+#: every quantity identification fits, each defined once with its bounds: the plant's constants
+#: (:data:`~ipfric_core.physics.params.PLANT_FIELDS`), the friction law's levels [N] (F_N = 1) and
+#: coefficients (:data:`~ipfric_core.physics.params.FRICTION_FIELDS`), and the undeclared effects under
+#: the names of :class:`~ipfric_core.physics.rig.PlantTruth` (:data:`~ipfric_core.physics.rig.PLANT_TRUTH_FIELDS`)
+PARAMS: dict[str, ParamSpec] = {p.name: p for p in (
+    *(_schema(PLANT_FIELDS, k, v) for k, v in (('M', 0.5), ('m', 0.1), ('l', 0.1), ('alpha', 1.0), ('beta', 5.0))),
+    ParamSpec('Fc', 'N', 0.0, 50.0, 0.3, 'Coulomb level mu_c F_N, eq. (6)'),
+    ParamSpec('Fs_excess', 'N', 0.0, 50.0, 0.3, 'static minus Coulomb level (mu_s - mu_c) F_N, eq. (5)'),
+    *(_schema(FRICTION_FIELDS, k, v) for k, v in (('eps', 2.0), ('v_s', 0.05), ('sigma0', 1e4), ('sigma1', 1.0))),
+    *(_schema(PLANT_TRUTH_FIELDS, k, v) for k, v in (
+        ('cogging_sin_N', 0.1), ('cogging_cos_N', 0.1), ('cogging_period_m', 0.01), ('offset_N', 0.1),
+        ('asymmetry', 0.2), ('asymmetry_viscous_Ns_per_m', 1.0), ('deadzone_V', 0.1), ('saturation_V', 5.0),
+        ('input_delay_s', 0.01), ('backlash_m', 1e-3), ('drive_backlash_m', 1e-3), ('drive_mass_kg', 0.2),
+        ('drive_stiffness_N_per_m', 1e5), ('drive_damping_Ns_per_m', 20.0), ('bias_theta_rad', 0.005))),
+)}
 
 
 @dataclass(frozen=True)
 class Effect:
-    """A candidate effect: parameters, where it acts, the signature that points to it."""
+    """A candidate effect: its parameters (names of :data:`PARAMS`; each starts at 0 unless the search
+    chooses a start from the data), where it acts, the signature that points to it."""
 
     name: str
     params: tuple
@@ -48,49 +82,50 @@ class Effect:
     requires: tuple = ()
     needs_theta: bool = False
 
+    @property
+    def specs(self) -> list[ParamSpec]:
+        return [PARAMS[n] for n in self.params]
 
-BASE_PARAMS = (ParamSpec('mass', 'kg', 1e-3, 1e4, None), ParamSpec('eps', 'N s/m', 0.0, 1e4, 0.0))
+
+#: the equation error's base model: the mass the force balance fits and the viscous slope
+BASE_PARAMS = ('M', 'eps')
 
 EFFECTS = {e.name: e for e in (
-    Effect('coulomb', (ParamSpec('Fc', 'N', 0.0, 1e4), ParamSpec('Fs_excess', 'N', 0.0, 1e4)), 'friction',
+    Effect('coulomb', ('Fc', 'Fs_excess'), 'friction',
            'velocity_sign', 'Coulomb and static friction, eqs. (4)-(7): Fc sgn(x\') while sliding, the '
            'cart held up to Fs = Fc + Fs_excess (seen at breakaway): the residual jumps across x\' = 0'),
-    Effect('stribeck', (ParamSpec('v_s', 'm/s', 1e-4, 10.0, None),), 'friction',
+    Effect('stribeck', ('v_s',), 'friction',
            'speed', 'the sliding level falls from Fs to Fc as exp(-(|x\'|/v_s)^2), eq. (8) with gamma = 2: '
            'the residual falls with speed at low |x\'|', requires=('coulomb',)),
-    Effect('presliding', (ParamSpec('sigma0', 'N/m', 1.0, 1e7, None), ParamSpec('sigma1', 'N s/m', 0.0, 1e5)),
+    Effect('presliding', ('sigma0', 'sigma1'),
            'friction', 'reversal', 'bristle (dynamic) friction, eqs. (10)-(11): sigma0 z replaces the '
            'sliding level; a transient after each reversal', requires=('coulomb',)),
-    Effect('asymmetry', (ParamSpec('asym', '', -0.9, 0.9), ParamSpec('asym_v', 'N s/m', -1e4, 1e4)), 'friction',
-           'direction', 'direction-dependent friction, the law of physics.friction: level (1 + asym) forward, '
-           '(1 - asym) backward, static included, viscous eps + asym_v sgn(x\'); the residual is even in '
-           'x\' (the same sign both ways) where friction misfits are odd'),
-    Effect('offset', (ParamSpec('F0', 'N', -1e4, 1e4),), 'force', 'mean',
+    Effect('asymmetry', ('asymmetry', 'asymmetry_viscous_Ns_per_m'), 'friction',
+           'direction', 'direction-dependent friction, the law of physics.friction: level (1 + asymmetry) forward, '
+           '(1 - asymmetry) backward, static included, viscous eps +/- asymmetry_viscous_Ns_per_m; the residual is '
+           'even in x\' (the same sign both ways) where friction misfits are odd'),
+    Effect('offset', ('offset_N',), 'force', 'mean',
            'a constant force (slope of the track, amplifier offset): the residual has a mean'),
-    Effect('cogging', (ParamSpec('cog_a', 'N', -1e4, 1e4), ParamSpec('cog_b', 'N', -1e4, 1e4),
-                       ParamSpec('cog_period', 'm', 1e-4, 10.0, None)), 'force', 'position',
-           'position-periodic force (motor cogging, screw ripple) A sin(2 pi x/P + phi) of physics.plant, '
-           'fitted as a sin + b cos (a = A cos phi, b = A sin phi): '
-           'a peak in the spectrum of the residual over position'),
-    Effect('backlash', (ParamSpec('gap', 'm', 0.0, 0.05),), 'sensor', 'reversal',
-           'play of width gap between cart and encoder: the measured position dwells at each '
-           'reversal while the cart moves gap; spikes of residual right after reversals'),
-    Effect('drive_backlash', (ParamSpec('drive_gap', 'm', 0.0, 0.05), ParamSpec('drive_mass', 'kg', 1e-3, 10.0, None),
-                              ParamSpec('drive_stiffness', 'N/m', 1e3, 1e6, None),
-                              ParamSpec('drive_damping', 'N s/m', 0.0, 1e3, None)), 'drive', 'reversal',
-           'play of width drive_gap between the motor side of the drive (mass drive_mass reflected to '
-           'the rack) and the cart, the encoder on the cart, a stiff contact beyond it '
-           '(physics.simulate.advance_drive): at a reversal of the drive force the cart coasts while '
-           'the motor side crosses the play, then takes a knock'),
-    Effect('deadzone', (ParamSpec('dz', 'input unit', 0.0, 1e3, None),), 'input', 'voltage',
+    Effect('cogging', ('cogging_sin_N', 'cogging_cos_N', 'cogging_period_m'), 'force', 'position',
+           'position-periodic force (motor cogging, screw ripple) a sin(2 pi x/P) + b cos(2 pi x/P) of '
+           'physics.plant: a peak in the spectrum of the residual over position'),
+    Effect('backlash', ('backlash_m',), 'sensor', 'reversal',
+           'play of width backlash_m between cart and encoder: the measured position dwells at each '
+           'reversal while the cart moves across it; spikes of residual right after reversals'),
+    Effect('drive_backlash', ('drive_backlash_m', 'drive_mass_kg', 'drive_stiffness_N_per_m', 'drive_damping_Ns_per_m'),
+           'drive', 'reversal',
+           'play between the motor side of the drive (its mass reflected to the rack) and the cart, the encoder '
+           'on the cart, a stiff contact beyond it (physics.simulate.advance_drive): at a reversal of the drive '
+           'force the cart coasts while the motor side crosses the play, then takes a knock'),
+    Effect('deadzone', ('deadzone_V',), 'input', 'voltage',
            'input deadzone: |u| < dz gives no force, beyond it u - sgn(u) dz; the residual is an odd '
            'step in u'),
-    Effect('saturation', (ParamSpec('u_max', 'input unit', 1e-6, 1e6, None),), 'input', 'voltage',
-           'the drive clips |u| at u_max: the residual grows with |u| beyond it'),
-    Effect('delay', (ParamSpec('delay', 's', 0.0, 0.5, None),), 'input', 'lag',
-           'transport delay between command and force (or sensor): the residual correlates with '
-           'the input\'s rate at a lag'),
-    Effect('sensor_bias', (ParamSpec('theta_bias', 'rad', -0.3, 0.3),), 'sensor', 'pendulum_mean',
+    Effect('saturation', ('saturation_V',), 'input', 'voltage',
+           'the drive clips |u| at saturation_V: the residual grows with |u| beyond it'),
+    Effect('delay', ('input_delay_s',), 'input', 'lag',
+           'transport delay between command and force (physics.rig.delayed_pieces): the residual correlates '
+           'with the input\'s rate at a lag'),
+    Effect('sensor_bias', ('bias_theta_rad',), 'sensor', 'pendulum_mean',
            'constant angle-encoder offset: the pendulum equation (4/3) l theta\'\' = g sin(theta) - '
            'x\'\' cos(theta) has a mean residual of about g * bias', needs_theta=True),
 )}
@@ -102,20 +137,14 @@ BASE_MODELS = {
 }
 
 
-def shifted(t: np.ndarray, u: np.ndarray, delay: float) -> np.ndarray:
-    """u(t - delay) by linear interpolation, held at u[0] before the start."""
-    if delay == 0.0:
-        return u
-    return np.interp(t - delay, t, u, left=u[0])
-
-
 def effective_input(t: np.ndarray, u: np.ndarray, p: dict, active) -> np.ndarray:
-    """u_eff: the input after delay, deadzone and saturation (same unit as u), the rig's law."""
+    """u_eff: the input after delay (its mean over each sample interval), deadzone and saturation (same
+    unit as u), the rig's law."""
     if 'delay' in active:
-        u = shifted(t, u, p['delay'])
+        u = delayed_means(t, u, p['input_delay_s'])
     if 'deadzone' in active or 'saturation' in active:
-        u = inputs_through(np.ascontiguousarray(u, float), p['dz'] if 'deadzone' in active else 0.0,
-                           p['u_max'] if 'saturation' in active else 0.0)
+        u = inputs_through(np.ascontiguousarray(u, float), p['deadzone_V'] if 'deadzone' in active else 0.0,
+                           p['saturation_V'] if 'saturation' in active else 0.0)
     return u
 
 
@@ -160,7 +189,8 @@ def fitted_friction_vector(p: dict, active) -> tuple:
     stribeck effect the dynamic law's level stays at Fc. Fc is floored at 1e-9 N, where the
     laws divide by the level.
     """
-    asym = {'asymmetry': p['asym'], 'asymmetry_viscous': p['asym_v']} if 'asymmetry' in active else {}
+    asym = ({'asymmetry': p['asymmetry'], 'asymmetry_viscous': p['asymmetry_viscous_Ns_per_m']}
+            if 'asymmetry' in active else {})
     if 'coulomb' not in active:
         return friction_vector(FrictionParams(model='viscous', eps=p['eps'], **asym), 1.0)
     fc = max(p['Fc'], 1e-9)
@@ -174,18 +204,20 @@ def fitted_friction_vector(p: dict, active) -> tuple:
     return friction_vector(law, 1.0)
 
 
-def static_level(p: dict, active) -> float:
-    """Fs [N]: the largest force static friction holds (0 without the coulomb effect), eq. (5)."""
-    return p['Fc'] + p['Fs_excess'] if 'coulomb' in active else 0.0
+def static_levels(p: dict, active) -> tuple[float, float]:
+    """(backward, forward) [N]: the largest force static friction holds against a push backward and
+    forward, (1 -/+ a) Fs with the direction dependence of the law (eq. 5 and
+    :func:`~ipfric_core.physics.friction.holding_margin`); (0, 0) without the coulomb effect."""
+    fp = fitted_friction_vector(p, active)
+    limit = static_limit(fp)
+    return (1.0 - fp[FP_ASYM]) * limit, (1.0 + fp[FP_ASYM]) * limit
 
 
 def position_force(x, p: dict, active):
     """Forces fixed to the track or constant (offset, cogging) as resistance [N]: minus the force
     on the cart of :func:`ipfric_core.physics.plant.undeclared_force`. They act at rest too."""
-    amp, phase, period = 0.0, 0.0, 1.0
-    if 'cogging' in active:
-        amp, phase, period = np.hypot(p['cog_a'], p['cog_b']), np.arctan2(p['cog_b'], p['cog_a']), p['cog_period']
-    ef = (float(amp), float(period), float(phase), float(p['F0']) if 'offset' in active else 0.0)
+    cog = (p['cogging_sin_N'], p['cogging_cos_N'], p['cogging_period_m']) if 'cogging' in active else (0.0, 0.0, 1.0)
+    ef = (*(float(c) for c in cog), float(p['offset_N']) if 'offset' in active else 0.0)
     return -undeclared_forces(ef, np.ascontiguousarray(x, float))   # resisting: minus the force on the cart
 
 

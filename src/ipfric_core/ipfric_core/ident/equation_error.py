@@ -81,9 +81,8 @@ class Prepared:
             raise ConfigError(f'{rec.name}: only {int(self.used.sum())} moving samples (|x\'| >= '
                               f'{rec.stick_velocity:g} m/s); the data hardly move the axis')
         self.n_used = int(self.used.sum())
-        steps = np.abs(np.diff(rec.x))
-        #: encoder count [m], the smallest step of x (a play below two counts is quantization)
-        self.resolution = float(steps[steps > 0].min())
+        #: encoder count [m] (a play below two counts is quantization)
+        self.resolution = rec.x_resolution
         self.vmax = float(np.quantile(np.abs(self.v[self.used]), 0.95))
 
     def _breakaways(self, rec: Record) -> None:
@@ -153,10 +152,10 @@ def balance(pr: Prepared, p: dict, active) -> Balance:
     y = rec.gain * uf
     x, v, a = pr.x, pr.v, pr.a
     if 'backlash' in active:
-        g = p['gap']
+        g = p['backlash_m']
         x, v, a = x + g * pr.Dx, v + g * pr.Dv, a + g * pr.Da
     pp = fitted_plant_vector(rec, p)
-    th = pr.th - p.get('theta_bias', 0.0) if pr.has_theta else np.zeros_like(a)
+    th = pr.th - p.get('bias_theta_rad', 0.0) if pr.has_theta else np.zeros_like(a)
     thd = pr.thd if pr.has_theta else np.zeros_like(a)
     model = required_forces(pp, a, th, thd) + rec.back_emf * v + fx.resisting_force(x, v, p, active, pr.dt)
     pend = pendulum_residuals(pp, a, th, pr.thdd) if pr.has_theta else None
@@ -168,9 +167,10 @@ def balance(pr: Prepared, p: dict, active) -> Balance:
         # smoothed as the cart's inertia smooths it)
         held = rec.gain * uf_full[pr.b_idx] - fx.position_force(pr.b_x, p, active)
         if pr.has_theta:
-            held = held_forces(pp, pr.b_th - p.get('theta_bias', 0.0), pr.b_thd, held)
-        # stuck: static friction held it, |held| <= Fs; breakaway: |held| >= Fs (eq. 5)
-        static = np.maximum(0.0, pr.b_kind * (np.abs(held) - fx.static_level(p, active)))
+            held = held_forces(pp, pr.b_th - p.get('bias_theta_rad', 0.0), pr.b_thd, held)
+        # stuck: static friction held it, held within the static levels; breakaway: beyond them (eq. 5)
+        back, fwd = fx.static_levels(p, active)
+        static = np.maximum(0.0, pr.b_kind * np.where(held >= 0.0, held - fwd, -held - back))
         if 'backlash' in active:  # a cart crossing the play moves while its encoder stands still
             static = np.where(np.abs(v[np.minimum(pr.b_idx // pr.q, len(v) - 1)]) >= rec.stick_velocity,
                               0.0, static)
@@ -181,7 +181,7 @@ def fitted_plant_vector(rec: Record, p: dict) -> tuple:
     """The plant vector of :mod:`ipfric_core.physics.plant` with the fitted mass: (M, m, l, g,
     gain, back-EMF), the pendulum's (m, l, g) when attached, else m = 0."""
     m, l, g = rec.pendulum if rec.pendulum is not None else (0.0, 1.0, 9.8)
-    return (float(p['mass']), float(m), float(l), float(g), float(rec.gain), float(rec.back_emf))
+    return (float(p['M']), float(m), float(l), float(g), float(rec.gain), float(rec.back_emf))
 
 
 def residual_vector(pr: Prepared, p: dict, active) -> np.ndarray:
@@ -193,10 +193,7 @@ def residual_vector(pr: Prepared, p: dict, active) -> np.ndarray:
 
 
 def param_specs(active) -> list:
-    specs = list(fx.BASE_PARAMS)
-    for e in active:
-        specs += list(fx.EFFECTS[e].params)
-    return specs
+    return [fx.PARAMS[n] for n in fx.BASE_PARAMS] + [s for e in active for s in fx.EFFECTS[e].specs]
 
 
 @dataclass
@@ -218,8 +215,8 @@ def fit(pr: Prepared, active, start: dict) -> Fit:
     names = [s.name for s in specs]
     umax = float(np.max(np.abs(pr.u_full)))
     # input effects may not switch the input off: a deadzone below half, a limit above a third of max |u|
-    lo = np.array([0.3 * umax if s.name == 'u_max' else s.lo for s in specs])
-    hi = np.array([0.5 * umax if s.name == 'dz' else s.hi for s in specs])
+    lo = np.array([0.3 * umax if s.name == 'saturation_V' else s.lo for s in specs])
+    hi = np.array([0.5 * umax if s.name == 'deadzone_V' else s.hi for s in specs])
     x0 = np.clip(np.array([start[nm] for nm in names], float), lo + 1e-12 * (hi - lo), hi - 1e-12 * (hi - lo))
 
     def fun(theta):
@@ -246,17 +243,17 @@ def starts(pr: Prepared, name: str, p: dict, active) -> list[dict]:
     """Start values of effect ``name``'s parameters (several for the nonlinear ones)."""
     b = balance(pr, p, active)
     sig = signature_scores(b.r[b.used], pr.t[b.used], b.x[b.used], b.v[b.used], b.u[b.used], pr.dt)
-    base = {s.name: (s.init if s.init is not None else 0.0) for s in fx.EFFECTS[name].params}
+    base = dict.fromkeys(fx.EFFECTS[name].params, 0.0)
     u_scale = float(np.std(pr.u_full)) or 1.0
     options = {
         'stribeck': [{'v_s': f * pr.vmax} for f in (0.05, 0.2, 0.6)],
         'coulomb': [{'Fc': 0.0, 'Fs_excess': 0.0}],
         'presliding': [{'sigma0': max(p.get('Fc', 1.0), 1e-3) / z} for z in (1e-2, 1e-3, 1e-4, 1e-5)],
-        'cogging': [{'cog_period': sig['position_period_m'] or 0.01}],
-        'deadzone': [{'dz': f * u_scale} for f in (0.02, 0.1, 0.3)],
-        'saturation': [{'u_max': f * float(np.max(np.abs(pr.u_full)))} for f in (0.6, 0.8, 0.95)],
-        'backlash': [{'gap': g} for g in (1e-4, 1e-3, 3e-3, 1e-2)],
-        'delay': [{'delay': d} for d in sorted({sig['lag_s'], *np.geomspace(1e-3, 0.2, 10).tolist()})],
+        'cogging': [{'cogging_period_m': sig['position_period_m'] or 0.01}],
+        'deadzone': [{'deadzone_V': f * u_scale} for f in (0.02, 0.1, 0.3)],
+        'saturation': [{'saturation_V': f * float(np.max(np.abs(pr.u_full)))} for f in (0.6, 0.8, 0.95)],
+        'backlash': [{'backlash_m': g} for g in (1e-4, 1e-3, 3e-3, 1e-2)],
+        'delay': [{'input_delay_s': d} for d in sorted({sig['lag_s'], *np.geomspace(1e-3, 0.2, 10).tolist()})],
     }.get(name, [{}])
     return [{**p, **base, **o} for o in options]
 
@@ -284,11 +281,11 @@ def resolved(pr: Prepared, name: str, f: Fit) -> bool:
     a deadzone whose force is below the residual's RMS."""
     p = f.params
     if name == 'deadzone':
-        return pr.rec.gain * p['dz'] > errors(pr, p, f.active)['rms']
+        return pr.rec.gain * p['deadzone_V'] > errors(pr, p, f.active)['rms']
     if name == 'backlash':
-        return p['gap'] > 2 * pr.resolution
+        return p['backlash_m'] > 2 * pr.resolution
     if name == 'cogging':
-        return np.ptp(pr.x) >= 5 * p['cog_period']
+        return np.ptp(pr.x) >= 5 * p['cogging_period_m']
     return True
 
 
@@ -348,7 +345,7 @@ def identify(est: Record, val: Record, base_model: str = 'viscous', allowed=None
         raise ConfigError(f'base model: {base_model!r} is not one of {", ".join(fx.BASE_MODELS)}')
     pe, pv = Prepared(est), Prepared(val)
     active = fx.BASE_MODELS[base_model]
-    start = {'mass': 1.0, 'eps': 0.0}
+    start = {'M': 1.0, 'eps': 0.0}
     lin = fit(pe, (), start)  # viscous first: mass and eps are linear, a good start for any base
     start = dict(lin.params)
     for e in active:
@@ -405,7 +402,7 @@ def identify_steady(plant, volts, vels, breakaway_volts) -> dict:
     def fun(theta):
         p = {'eps': theta[0], 'Fc': theta[1], 'Fs_excess': theta[2]}
         slide = plant.alpha * V - plant.beta * v - fx.resisting_force(np.zeros_like(v), v, p, active, 1.0)
-        return np.concatenate([slide, plant.alpha * Vs - fx.static_level(p, active)])
+        return np.concatenate([slide, plant.alpha * Vs - fx.static_levels(p, active)[1]])
     sol = least_squares(fun, [1.0, 0.1, 0.1], bounds=([0, 0, 0], [1e3, 1e3, 1e3]))
     r = sol.fun
     cov = np.linalg.inv(sol.jac.T @ sol.jac) * float(r @ r) / max(1, len(r) - 3)
@@ -425,11 +422,8 @@ def identify_steady(plant, volts, vels, breakaway_volts) -> dict:
 def model_vectors(rec: Record, p: dict, active):
     """The fitted force balance as the physics' arguments (:class:`ident.model.ModelVectors`), for
     its simulation error: mass, drive gain and back-EMF as the plant, no pendulum."""
-    from .model import ModelVectors
-    amp, phase = (math.hypot(p['cog_a'], p['cog_b']), math.atan2(p['cog_b'], p['cog_a'])) if 'cogging' in active \
-        else (0.0, 0.0)
-    return ModelVectors(fitted_plant_vector(rec, p), fx.fitted_friction_vector(p, active),
-                        (amp, p.get('cog_period', 1.0), phase, p.get('F0', 0.0)),
-                        p.get('dz', 0.0) * ('deadzone' in active), p.get('u_max', 0.0) * ('saturation' in active),
-                        p.get('gap', 0.0) * ('backlash' in active),
-                        p.get('theta_bias', 0.0), p.get('delay', 0.0) * ('delay' in active))
+    from ..physics.rig import PlantTruth
+    from .model import TRUTH_PARAMS, ModelVectors
+    truth = PlantTruth(**{n: p[n] for e in active if e in fx.EFFECTS for n in fx.EFFECTS[e].params
+                          if n in TRUTH_PARAMS})
+    return ModelVectors(fitted_plant_vector(rec, p), fx.fitted_friction_vector(p, active), truth)

@@ -43,13 +43,12 @@ import numpy as np
 
 from ..analysis.records import Record
 from ..physics.params import ConfigError
-from ..physics.rig import inputs_through
 from . import lsq, shooting
-from .effects import EFFECTS
+from .effects import EFFECTS, PARAMS
 from .equation_error import BOOTSTRAP, P_VALUE
 from .model import LADDER_EFFECTS, Model
 
-__all__ = ['TYPICAL', 'Problem', 'Step', 'run_ladder']
+__all__ = ['Problem', 'Step', 'run_ladder']
 
 SIM_GAIN_PERCENT = 2.0
 MIN_DROP_COUNTS = 0.05   # and by at least this much RMS [counts] (rounding alone leaves 0.29 count)
@@ -72,13 +71,6 @@ SCREEN_SAMPLES = 30000
 SCREEN_NFEV = 12         # steps of a candidate's short fit
 FULL_SHARE = 0.5         # a candidate is fitted in full when its short fit gains this share of the best one's
 REDO_GAIN = 0.1          # a short fit that gains this much on a subset of windows and nothing on all is redone on all
-
-#: typical size of each parameter (the fit works on value / size)
-TYPICAL = {'M': 0.5, 'm': 0.1, 'l': 0.1, 'alpha': 1.0, 'beta': 5.0, 'Fc': 0.3, 'Fs_excess': 0.3, 'eps': 2.0,
-           'v_s': 0.05, 'dz': 0.1, 'u_max': 5.0, 'delay': 0.01, 'cog_a': 0.1, 'cog_b': 0.1, 'cog_period': 0.01,
-           'asym': 0.2, 'asym_v': 1.0, 'F0': 0.1, 'theta_bias': 0.005, 'gap': 1e-3, 'drive_gap': 1e-3,
-           'drive_mass': 0.2, 'drive_stiffness': 1e5, 'drive_damping': 20.0}
-
 
 class Problem:
     """A record cut into windows, and the simulation error of a model on it: the cart's
@@ -184,7 +176,7 @@ def fit_model(pr: Problem, model: Model, max_nfev: int = MAX_NFEV, only=None, pr
     free = [p for p in model.free if only is None or p.name in only]
     if not free:
         return model, {}
-    scale = np.array([max(abs(p.value), TYPICAL.get(p.name, 1.0)) for p in free])
+    scale = np.array([max(abs(p.value), PARAMS[p.name].typical) for p in free])
     lo = np.array([p.lo for p in free]) / scale
     hi = np.array([p.hi for p in free]) / scale
     x0 = np.clip(np.array([p.value for p in free]) / scale, lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
@@ -192,7 +184,7 @@ def fit_model(pr: Problem, model: Model, max_nfev: int = MAX_NFEV, only=None, pr
     ref = {p.name: p.value for p in prior.params} if prior is not None else {}
     anchored = [i for i, nm in enumerate(names) if nm in ref]
     z0 = np.array([ref[names[i]] for i in anchored]) / scale[anchored] if anchored else np.zeros(0)
-    sd = PRIOR_REL * np.maximum(np.abs(z0), np.array([TYPICAL.get(names[i], 1.0) for i in anchored]) / scale[anchored])
+    sd = PRIOR_REL * np.maximum(np.abs(z0), np.array([PARAMS[names[i]].typical for i in anchored]) / scale[anchored])
     weight = PRIOR_COUNTS * math.sqrt(pr.n_samples)
     lin_jac = np.zeros((len(anchored), len(names)))
     lin_jac[np.arange(len(anchored)), anchored] = weight / sd
@@ -329,9 +321,9 @@ def drive_crossings(pr: Problem, model: Model) -> np.ndarray:
     to contact on the other: a reversal of the drive force), run along ``pr``'s record
     (:func:`shooting.drive_states`)."""
     rec, vec = pr.rec, model.vectors()
-    u = shooting.delayed(rec.t, rec.u, vec.delay)
-    u = inputs_through(np.ascontiguousarray(u, float), vec.deadzone, vec.saturation)
-    side = shooting.drive_states(vec.pp, vec.drive[0], vec.drive[1], rec.t, u, pr.blocks[0][1].motion)[:, 2]
+    drive = vec.truth.drive_vector()
+    side = shooting.drive_states(vec.pp, drive[0], drive[1], rec.t, shooting.applied_commands(vec, rec),
+                                 pr.blocks[0][1].motion)[:, 2]
     touch = np.flatnonzero(side != 0.0)
     if len(touch) < 2:
         return np.zeros(0)
@@ -343,35 +335,37 @@ def drive_crossings(pr: Problem, model: Model) -> np.ndarray:
 def contradictions(pr: Problem, model: Model, name: str) -> list[str]:
     """Why the data refute the fitted effect ``name`` (empty when nothing does)."""
     rec = pr.rec
-    own = {s.name for s in EFFECTS[name].params}
+    own = set(EFFECTS[name].params)
     why = [f'{p.name} = {p.value:.4g} {p.unit} ends on its bound [{p.lo:g}, {p.hi:g}]'
-           for p in model.params if p.free and p.name in own and p.at_bound(1e-3 * TYPICAL.get(p.name, 1.0))]
+           for p in model.params if p.free and p.name in own and p.at_bound(1e-3 * PARAMS[p.name].typical)]
     if name == 'deadzone':
         low = smallest_moving_command(rec)
-        if low is not None and model['dz'] >= low:
-            why.append(f'deadzone {model["dz"]:.3g} V is not below {low:.3g} V, a command that moved the cart')
+        if low is not None and model['deadzone_V'] >= low:
+            why.append(f'deadzone {model["deadzone_V"]:.3g} V is not below {low:.3g} V, a command that moved the cart')
     if name == 'saturation':
-        share = float(np.mean(np.abs(rec.u) > model['u_max']))
+        share = float(np.mean(np.abs(rec.u) > model['saturation_V']))
         if share < 0.01:
-            why.append(f'saturation at {model["u_max"]:.3g} V clips {100 * share:.2g} % of the commands (needs 1 %)')
-        above = sorted((u, s) for u, s in steady_speeds(rec) if u > model['u_max'])
+            why.append(f'saturation at {model["saturation_V"]:.3g} V clips {100 * share:.2g} % of the commands '
+                       f'(needs 1 %)')
+        above = sorted((u, s) for u, s in steady_speeds(rec) if u > model['saturation_V'])
         if len(above) >= 2 and above[-1][1] > 1.05 * above[0][1] and above[-1][0] > 1.05 * above[0][0]:
-            why.append(f'saturation at {model["u_max"]:.3g} V, but the steady speed still grew from '
+            why.append(f'saturation at {model["saturation_V"]:.3g} V, but the steady speed still grew from '
                        f'{above[0][1]:.3g} m/s at {above[0][0]:.3g} V to {above[-1][1]:.3g} m/s '
                        f'at {above[-1][0]:.3g} V')
     if name == 'delay':
         lag = response_lag(rec)
-        if model['delay'] > lag + 2 * rec.dt:
-            why.append(f'delay {model["delay"] * 1e3:.3g} ms exceeds the lag at which the cart answers the '
+        if model['input_delay_s'] > lag + 2 * rec.dt:
+            why.append(f'delay {model["input_delay_s"] * 1e3:.3g} ms exceeds the lag at which the cart answers the '
                        f'command ({lag * 1e3:.3g} ms)')
-    if name == 'cogging' and np.ptp(rec.x) < 3 * model['cog_period']:
-        why.append(f'cogging period {model["cog_period"] * 1e3:.3g} mm: fewer than 3 periods over the travel '
+    if name == 'cogging' and np.ptp(rec.x) < 3 * model['cogging_period_m']:
+        why.append(f'cogging period {model["cogging_period_m"] * 1e3:.3g} mm: fewer than 3 periods over the travel '
                    f'({np.ptp(rec.x) * 1e3:.3g} mm)')
-    if name == 'backlash' and model['gap'] < 2 * rec.x_resolution:
-        why.append(f'play {model["gap"] * 1e3:.3g} mm is below two encoder counts (quantization)')
+    if name == 'backlash' and model['backlash_m'] < 2 * rec.x_resolution:
+        why.append(f'play {model["backlash_m"] * 1e3:.3g} mm is below two encoder counts (quantization)')
     if name == 'drive_backlash':
-        if model['drive_gap'] < 2 * rec.x_resolution:
-            why.append(f'drive play {model["drive_gap"] * 1e3:.3g} mm is below two encoder counts (quantization)')
+        if model['drive_backlash_m'] < 2 * rec.x_resolution:
+            why.append(f'drive play {model["drive_backlash_m"] * 1e3:.3g} mm is below two encoder counts '
+                       f'(quantization)')
         crossings = drive_crossings(pr, model)
         if len(crossings) < 3:
             why.append(f'the motor side crosses its play at {len(crossings)} reversals of the drive force '
@@ -383,8 +377,9 @@ def contradictions(pr: Problem, model: Model, name: str) -> list[str]:
 
 
 #: the parameters that give an effect its size (zero = no effect)
-SIZE = {'deadzone': ('dz',), 'delay': ('delay',), 'cogging': ('cog_a', 'cog_b'), 'asymmetry': ('asym', 'asym_v'),
-        'offset': ('F0',), 'sensor_bias': ('theta_bias',), 'backlash': ('gap',), 'drive_backlash': ('drive_gap',)}
+SIZE = {'deadzone': ('deadzone_V',), 'delay': ('input_delay_s',), 'cogging': ('cogging_sin_N', 'cogging_cos_N'),
+        'asymmetry': ('asymmetry', 'asymmetry_viscous_Ns_per_m'), 'offset': ('offset_N',),
+        'sensor_bias': ('bias_theta_rad',), 'backlash': ('backlash_m',), 'drive_backlash': ('drive_backlash_m',)}
 
 
 def unresolved(model: Model, std: dict, name: str) -> list[str]:
@@ -406,21 +401,21 @@ def effect_starts(pr: Problem, model: Model, name: str, prior: Model) -> list[di
     also name other parameters of ``model`` (``prior``: the declared model)."""
     rec = pr.rec
     if name == 'cogging':
-        return [{'cog_period': p} for p in (0.002, 0.0035, 0.006, 0.01, 0.015, 0.02)]
+        return [{'cogging_period_m': p} for p in (0.002, 0.0035, 0.006, 0.01, 0.015, 0.02)]
     if name == 'delay':
-        return [{'delay': d} for d in sorted({0.003, 0.01, 0.02, round(response_lag(rec), 4) or 0.001})]
+        return [{'input_delay_s': d} for d in sorted({0.003, 0.01, 0.02, round(response_lag(rec), 4) or 0.001})]
     if name == 'deadzone':
         low = smallest_moving_command(rec) or 0.5
-        return [{'dz': f * low} for f in (0.2, 0.5)]
+        return [{'deadzone_V': f * low} for f in (0.2, 0.5)]
     if name == 'saturation':
         umax = float(np.max(np.abs(rec.u)))
-        return [{'u_max': f * umax} for f in (0.5, 0.8)]
+        return [{'saturation_V': f * umax} for f in (0.5, 0.8)]
     if name == 'backlash':
-        return [{'gap': g} for g in (3e-4, 1e-3, 3e-3)]
+        return [{'backlash_m': g} for g in (3e-4, 1e-3, 3e-3)]
     if name == 'drive_backlash':
         return drive_starts(pr, model, prior)
     if name == 'sensor_bias':
-        return [{'theta_bias': float(np.mean(rec.theta)) if rec.theta is not None else 0.0}]
+        return [{'bias_theta_rad': float(np.mean(rec.theta)) if rec.theta is not None else 0.0}]
     return [{}]
 
 
@@ -444,8 +439,8 @@ def drive_starts(pr: Problem, model: Model, prior: Model, keep: int = 2) -> list
         reduced = mass * model['M'] / (mass + model['M'])
         for f in freqs:
             k = reduced * (2 * math.pi * f) ** 2
-            grid += [{'drive_gap': g, 'drive_mass': mass, 'drive_stiffness': k,
-                      'drive_damping': 2 * zeta * math.sqrt(k * reduced), **law} for g in gaps]
+            grid += [{'drive_backlash_m': g, 'drive_mass_kg': mass, 'drive_stiffness_N_per_m': k,
+                      'drive_damping_Ns_per_m': 2 * zeta * math.sqrt(k * reduced), **law} for g in gaps]
     costs = [pr.cart_cost(model.with_effect('drive_backlash', p).with_values(p)) for p in grid]
     return [grid[i] for i in np.argsort(costs)[:keep]]
 
@@ -462,9 +457,9 @@ def short_fit(pe: Problem, current: Model, name: str, prior: Model, ps: Problem 
     fits are done again on ``pe``; on the subset, the gain is counted from the friction levels
     refitted there alone (:meth:`Problem.baseline`), not from ``current``."""
     ps = ps or pe
-    own = {s.name for s in EFFECTS[name].params}
+    own = set(EFFECTS[name].params)
     levels = {p.name for p in current.free} & {'Fc', 'Fs_excess'}
-    screen = (own - {'cog_period'}) | levels
+    screen = (own - {'cogging_period_m'}) | levels
     starts = [current.with_effect(name, s).with_values(s) for s in effect_starts(ps, current, name, prior)]
     if name in GRID_SCREENED:
         costs = [ps.cart_cost(m) for m in starts]
@@ -488,7 +483,7 @@ def short_fit(pe: Problem, current: Model, name: str, prior: Model, ps: Problem 
 def full_fit(pe: Problem, current: Model, best: Model, name: str, prior: Model) -> tuple[Model, dict]:
     """The fit of the effect's own parameters with the friction law's levels and slope from the short
     fit ``best``, with standard errors."""
-    own = {s.name for s in EFFECTS[name].params}
+    own = set(EFFECTS[name].params)
     joint = own | ({p.name for p in current.free} & {'Fc', 'Fs_excess', 'eps'})
     return fit_model(pe, best, only=joint, prior=prior, profile=SIZE.get(name, ()))
 
@@ -521,10 +516,10 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
     notes = []
     for p in refit.free:
         old = declared.param(p.name).value
-        if abs(p.value - old) > REFIT_NOTE * max(abs(old), TYPICAL.get(p.name, 1.0)):
+        if abs(p.value - old) > REFIT_NOTE * max(abs(old), PARAMS[p.name].typical):
             notes.append(f'{p.name} refitted from {old:.4g} to {p.value:.4g} {p.unit} '
                          f'({100 * (p.value - old) / (abs(old) or 1):+.0f} %): the declared model misses something')
-        if p.at_bound(1e-3 * TYPICAL.get(p.name, 1.0)):
+        if p.at_bound(1e-3 * PARAMS[p.name].typical):
             notes.append(f'{p.name} = {p.value:.4g} {p.unit} ends on its bound [{p.lo:g}, {p.hi:g}]: the data '
                          f'contradict the declared law there')
     steps.append(Step('refit', refit, std, pe.summary(refit), pv.summary(refit), notes))
@@ -571,7 +566,7 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
                     why.append(f'validation {key.split("_")[0]} error rises from {before[key]:.3g} to '
                                f'{after[key]:.3g} counts')
             tried.append({'effect': name, 'validation_gain_percent': gain, 'p_value': pval,
-                          'values': {s.name: m[s.name] for s in EFFECTS[name].params}, 'refused': why, 'kept': False})
+                          'values': {n: m[n] for n in EFFECTS[name].params}, 'refused': why, 'kept': False})
             say(f'  tried {name:<11} gain {gain:6.2f} %  p {pval:.2g}  ' + ('; '.join(why) or 'passes'))
             ranked.append((gain, name, m, s, why, len(tried) - 1))
         ok = [r for r in ranked if not r[4]]

@@ -14,7 +14,8 @@ import numpy as np  # noqa: E402
 
 from ..physics.friction import friction_force  # noqa: E402
 from . import shooting  # noqa: E402
-from .ladder import TYPICAL, Problem, Step  # noqa: E402
+from .effects import PARAMS  # noqa: E402
+from .ladder import Problem, Step  # noqa: E402
 from .report import save_figure, write_report  # noqa: E402
 
 __all__ = ['correlation_lines', 'write_ladder_report']
@@ -31,7 +32,7 @@ def param_table(step: Step) -> list[dict]:
     rough, flat = getattr(step.std, 'rough', ()), getattr(step.std, 'flat', ())
     reach = getattr(step.std, 'reach', {})
     return [{'name': p.name, 'value': p.value, 'std': step.std.get(p.name), 'unit': p.unit,
-             'fitted': p.free, 'at_bound': p.at_bound(1e-3 * TYPICAL.get(p.name, 1.0)), 'doc': p.doc,
+             'fitted': p.free, 'at_bound': p.at_bound(1e-3 * PARAMS[p.name].typical), 'doc': p.doc,
              'rough': p.name in rough, 'flat': p.name in flat, 'unconfined': reach.get(p.name, '')}
             for p in step.model.params]
 
@@ -114,7 +115,8 @@ def friction_curve(step: Step, at: dict) -> list[dict]:
     errors: Any = step.std
     if not hasattr(errors, 'cov') or not at:
         return []
-    names = [n for n in errors.names if n in ('Fc', 'Fs_excess', 'eps', 'v_s', 'asym', 'asym_v')]
+    names = [n for n in errors.names if n in ('Fc', 'Fs_excess', 'eps', 'v_s', 'asymmetry',
+                                                 'asymmetry_viscous_Ns_per_m')]
     if not names:
         return []
     index = [errors.names.index(n) for n in names]
@@ -127,7 +129,7 @@ def friction_curve(step: Step, at: dict) -> list[dict]:
         f0 = force(step.model, v)
         grad = []
         for n in names:
-            h = 1e-6 * max(abs(step.model[n]), TYPICAL.get(n, 1.0))
+            h = 1e-6 * max(abs(step.model[n]), PARAMS[n].typical)
             grad.append((force(step.model.with_values({n: step.model[n] + h}), v) - f0) / h)
         g = np.array(grad)
         out.append({'speed': key, 'v': v, 'force': f0, 'std': float(math.sqrt(max(g @ cov @ g, 0.0)))})

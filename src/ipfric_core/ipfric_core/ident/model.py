@@ -8,21 +8,20 @@ parameters of each added effect are fitted. :meth:`Model.vectors` turns the valu
 the arguments of :mod:`ipfric_core.physics` (plant vector, friction vector, forces fixed
 to the track, input and sensor effects): the model that is fitted is the model the
 simulator runs, and :meth:`Model.friction_params` / :meth:`Model.plant_truth` export it
-whole (cogging phase, asymmetry, offset included).
+whole: the effects' parameters are the fields of :class:`~ipfric_core.physics.rig.PlantTruth`.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, replace
 
 from ..physics.friction import friction_vector
 from ..physics.params import ConfigError, FrictionParams, PlantParams
 from ..physics.plant import plant_vector
 from ..physics.rig import PlantTruth
-from .effects import EFFECTS
+from .effects import EFFECTS, PARAMS
 
-__all__ = ['PLANT_KNOWN', 'FRICTION_FITTED', 'LADDER_EFFECTS', 'ModelVectors', 'Model', 'declared', 'read_declared',
-           'load_declared']
+__all__ = ['Param', 'PLANT_KNOWN', 'LAW_PARAMS', 'FRICTION_FITTED', 'LADDER_EFFECTS', 'TRUTH_PARAMS', 'param',
+           'ModelVectors', 'Model', 'declared', 'read_declared', 'load_declared']
 
 
 @dataclass(frozen=True)
@@ -42,41 +41,36 @@ class Param:
         return self.free and (self.value - self.lo <= tol or self.hi - self.value <= tol)
 
 
-PLANT_KNOWN = {  # name -> (unit, lo, hi, doc); frozen unless freed
-    'M': ('kg', 0.05, 50.0, 'cart mass'),
-    'm': ('kg', 0.0, 10.0, 'pendulum mass'),
-    'l': ('m', 0.01, 2.0, 'pivot to pendulum centre of mass'),
-    'alpha': ('N/V', 0.01, 100.0, 'motor force per volt, eq. (2)'),
-    'beta': ('N s/m', 0.0, 200.0, 'motor back-EMF damping, eq. (2)'),
-}
-FRICTION_FITTED = {  # name -> (unit, lo, hi, doc), per declared law
-    'Fc': ('N', 0.0, 50.0, 'Coulomb level mu_c F_N, eq. (6)'),
-    'Fs_excess': ('N', 0.0, 50.0, 'static minus Coulomb level (mu_s - mu_c) F_N, eq. (5)'),
-    'eps': ('N s/m', 0.0, 200.0, 'viscous coefficient, eq. (3)'),
-    'v_s': ('m/s', 1e-3, 2.0, 'Stribeck velocity, eq. (8)'),
-}
+#: the plant's known constants (Table 1 and eq. 2): frozen unless freed by name
+PLANT_KNOWN = ('M', 'm', 'l', 'alpha', 'beta')
+#: the friction parameters each declared law fits (levels in N: the same for any normal force)
 LAW_PARAMS = {'viscous': ('eps',), 'coulomb': ('Fc', 'Fs_excess', 'eps'),
               'exponential': ('Fc', 'Fs_excess', 'eps', 'v_s')}
+#: every friction parameter a declared law may fit
+FRICTION_FITTED = LAW_PARAMS['exponential']
 
 #: Effects the ladder adds, from the one library of :mod:`ipfric_core.ident.effects` (the base
 #: law's coulomb, stribeck and presliding are the declared friction here).
 LADDER_EFFECTS = ('deadzone', 'saturation', 'delay', 'cogging', 'asymmetry', 'offset', 'sensor_bias', 'backlash',
                   'drive_backlash')
+#: the effects' parameters that are fields of PlantTruth (all of them)
+TRUTH_PARAMS = tuple(n for e in LADDER_EFFECTS for n in EFFECTS[e].params)
+
+
+def param(name: str, value: float, free: bool) -> Param:
+    """Parameter ``name`` of :data:`~ipfric_core.ident.effects.PARAMS` at ``value``."""
+    s = PARAMS[name]
+    return Param(name, float(value), s.unit, s.lo, s.hi, free, s.doc)
 
 
 @dataclass(frozen=True)
 class ModelVectors:
-    """The arguments of the physics functions for one set of parameter values."""
+    """The arguments of the physics functions for one set of parameter values: the plant vector,
+    the friction vector and the undeclared effects (input delay not rounded)."""
 
     pp: tuple
     fp: tuple
-    ef: tuple
-    deadzone: float
-    saturation: float
-    gap: float
-    theta_bias: float
-    delay: float
-    drive: tuple = (0.0, 0.0, 0.0, 0.0)   # play [m], motor-side mass [kg], contact k [N/m], c [N s/m]
+    truth: PlantTruth
 
 
 @dataclass(frozen=True)
@@ -112,10 +106,8 @@ class Model:
                                           for p in self.params))
 
     def with_effect(self, name: str, starts: dict | None = None) -> Model:
-        """This model with effect ``name`` added (its parameters free, at ``starts`` or defaults)."""
-        e = EFFECTS[name]
-        new = tuple(Param(s.name, float((starts or {}).get(s.name, s.init or 0.0)), s.unit, s.lo, s.hi, True, e.doc)
-                    for s in e.params)
+        """This model with effect ``name`` added (its parameters free, at ``starts`` or 0)."""
+        new = tuple(param(n, (starts or {}).get(n, 0.0), True) for n in EFFECTS[name].params)
         return replace(self, params=self.params + new, effects=self.effects + (name,))
 
     def freeing(self, names) -> Model:
@@ -131,39 +123,28 @@ class Model:
         fc = self.get('Fc')
         return FrictionParams(model=self.law, eps=self['eps'], mu_c=fc / fn,
                               mu_s=(fc + self.get('Fs_excess')) / fn, v_s=self.get('v_s', 0.105),
-                              gamma=self.gamma, asymmetry=self.get('asym'),
-                              asymmetry_viscous=self.get('asym_v'))
+                              gamma=self.gamma)
 
     def plant_params(self) -> PlantParams:
         return PlantParams(M=self['M'], m=max(self['m'], 1e-6), l=self['l'], g=self.g,
                            alpha=self['alpha'], beta=self['beta'])
 
-    def cogging(self) -> tuple[float, float, float]:
-        """(A [N], P [m], phi [rad]) of A sin(2 pi x / P + phi)."""
-        a, b = self.get('cog_a'), self.get('cog_b')
-        return math.hypot(a, b), self.get('cog_period', 0.01), math.atan2(b, a)
-
-    def plant_truth(self, dt: float) -> PlantTruth:
-        """The added effects as the simulator's ``plant_truth`` (delay rounded to samples)."""
-        amp, period, phase = self.cogging()
-        return PlantTruth(cogging_N=amp, cogging_period_m=period, cogging_phase_rad=phase,
-                          offset_N=self.get('F0'), deadzone_V=self.get('dz'), saturation_V=self.get('u_max'),
-                          input_delay_s=round(self.get('delay') / dt) * dt, backlash_m=self.get('gap'),
-                          drive_backlash_m=self.get('drive_gap'), drive_mass_kg=self.get('drive_mass'),
-                          drive_stiffness_N_per_m=self.get('drive_stiffness'),
-                          drive_damping_Ns_per_m=self.get('drive_damping'),
-                          bias_theta_rad=self.get('theta_bias'))
+    def plant_truth(self, dt: float | None = None) -> PlantTruth:
+        """The added effects as the simulator's ``plant_truth`` (with a sample period ``dt`` [s], the
+        input delay rounded to whole samples, as a rig applies it); the direction dependence of the
+        friction (asymmetry) is the truth's too."""
+        values: dict = {n: self.get(n) for n in TRUTH_PARAMS if any(p.name == n for p in self.params)}
+        if dt is not None and 'input_delay_s' in values:
+            values['input_delay_s'] = round(values['input_delay_s'] / dt) * dt
+        return PlantTruth(**values)
 
     def vectors(self) -> ModelVectors:
         pp = list(plant_vector(self.plant_params()))
         if not self.pendulum:
             pp[1] = 0.0
-        amp, period, phase = self.cogging()
-        return ModelVectors(tuple(pp), friction_vector(self.friction_params(), self.normal_force),
-                            (amp, period, phase, self.get('F0')), self.get('dz'), self.get('u_max'),
-                            self.get('gap'), self.get('theta_bias'), self.get('delay'),
-                            (self.get('drive_gap'), self.get('drive_mass'), self.get('drive_stiffness'),
-                             self.get('drive_damping')))
+        truth = self.plant_truth()
+        return ModelVectors(tuple(pp), friction_vector(truth.true_friction(self.friction_params()),
+                                                       self.normal_force), truth)
 
 
 def declared(plant: PlantParams, friction: FrictionParams, pendulum: bool) -> Model:
@@ -172,13 +153,10 @@ def declared(plant: PlantParams, friction: FrictionParams, pendulum: bool) -> Mo
     if friction.model not in LAW_PARAMS:
         raise ConfigError(f'friction.model: {friction.model!r} cannot be identified; allowed: '
                           f'{", ".join(LAW_PARAMS)}')
-    params = [Param(k, float(getattr(plant, k)), *PLANT_KNOWN[k][:3], False, PLANT_KNOWN[k][3])
-              for k in PLANT_KNOWN]
+    params = [param(k, getattr(plant, k), False) for k in PLANT_KNOWN]
     values = {'Fc': friction.mu_c * fn, 'Fs_excess': (friction.mu_s - friction.mu_c) * fn,
               'eps': friction.eps, 'v_s': friction.v_s}
-    for k in LAW_PARAMS[friction.model]:
-        unit, lo, hi, doc = FRICTION_FITTED[k]
-        params.append(Param(k, float(values[k]), unit, lo, hi, True, doc))
+    params += [param(k, values[k], True) for k in LAW_PARAMS[friction.model]]
     return Model(friction.model, tuple(params), (), friction.gamma, plant.g, fn, pendulum)
 
 

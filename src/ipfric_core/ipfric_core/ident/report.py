@@ -10,6 +10,7 @@ matplotlib.use('Agg')
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from ..physics.plant import cogging_amplitude_phase  # noqa: E402
 from . import effects as fx  # noqa: E402
 from . import shooting  # noqa: E402
 from .equation_error import analyse, balance, errors, model_vectors, param_specs  # noqa: E402
@@ -28,7 +29,8 @@ def friction_summary(params: dict, active, normal_force: float) -> dict:
         if k in params:
             out[k] = params[k]
     if 'cogging' in active:
-        out['cogging_amplitude_N'] = float(np.hypot(params['cog_a'], params['cog_b']))
+        out['cogging_amplitude_N'], out['cogging_phase_rad'] = cogging_amplitude_phase(params['cogging_sin_N'],
+                                                                                       params['cogging_cos_N'])
     return out
 
 

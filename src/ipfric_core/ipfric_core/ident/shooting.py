@@ -28,11 +28,11 @@ from scipy.signal import butter, sosfiltfilt
 from ..analysis.records import Record
 from ..physics.compiled import compiled
 from ..physics.plant import motor_force, motor_side_free
-from ..physics.rig import input_effects, inputs_through, play
+from ..physics.rig import delayed_means, delayed_pieces, input_effects, inputs_through, play
 from ..physics.simulate import advance, advance_drive
 
-__all__ = ['rates', 'every', 'cart_windows', 'angle_windows', 'drive_states', 'delayed', 'predict', 'reading_errors',
-           'summary', 'window_sse']
+__all__ = ['rates', 'every', 'cart_windows', 'angle_windows', 'drive_states', 'applied_commands', 'predict',
+           'reading_errors', 'summary', 'window_sse']
 
 CART_WINDOW_S = 1.0
 PENDULUM_WINDOW_S = 0.25
@@ -189,12 +189,14 @@ def drive_states(pp, gap, mass, t, u, motion):
 
 
 @compiled(parallel=True)   # the windows are independent: one thread each
-def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, drive0, t, u, start, stop, state, held,
-           substep, forced, out):
-    """Encoder readings (x, theta) predicted in every window, written into ``out`` (n, 2).
-    Without a pendulum (pp's m = 0) the angle is held at 0; with ``forced`` (n, 2) rows, the
-    angle and its rate are set to them (less the bias) after every sample. With a drive play
-    (``drive`` as :func:`~ipfric_core.physics.simulate.advance_drive` takes it, play > 0) each
+def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, drive0, t, first, durations, commands,
+           start, stop, state, held, substep, forced, out):
+    """Encoder readings (x, theta) predicted in every window, written into ``out`` (n, 2). Each
+    sample interval k is integrated over its pieces of constant applied command (``first``,
+    ``durations``, ``commands`` of :func:`~ipfric_core.physics.rig.delayed_pieces`), each through
+    the input effects. Without a pendulum (pp's m = 0) the angle is held at 0; with ``forced`` (n, 2)
+    rows, the angle and its rate are set to them (less the bias) after every sample. With a drive
+    play (``drive`` as :func:`~ipfric_core.physics.simulate.advance_drive` takes it, play > 0) each
     window starts from the drive state ``drive0`` (n_windows, 2+) of :func:`drive_states`."""
     pendulum = pp[1] > 0.0
     force = len(forced) > 0
@@ -209,11 +211,12 @@ def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, drive0, t, 
             # prediction (written by another thread: not overwritten here)
             out[k0, 0], out[k0, 1] = reading, s[1] + theta_bias
         for k in range(k0, stop[w] - 1):
-            v = input_effects(u[k], deadzone, saturation)
-            if drive[0] > 0.0:
-                s, mode, dr = advance_drive(pp, fp, ef, s, mode, dr, v, t[k + 1] - t[k], substep, drive)
-            else:
-                s, mode = advance(pp, fp, ef, s, mode, v, t[k + 1] - t[k], substep)
+            for j in range(first[k], first[k + 1]):
+                v = input_effects(commands[j], deadzone, saturation)
+                if drive[0] > 0.0:
+                    s, mode, dr = advance_drive(pp, fp, ef, s, mode, dr, v, durations[j], substep, drive)
+                else:
+                    s, mode = advance(pp, fp, ef, s, mode, v, durations[j], substep)
             if force:
                 s = (s[0], forced[k + 1, 0] - theta_bias, s[2], forced[k + 1, 1], s[4])
             elif not pendulum:
@@ -226,17 +229,12 @@ def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, drive0, t, 
             out[k + 1, 0], out[k + 1, 1] = reading, s[1] + theta_bias
 
 
-def delayed(t: np.ndarray, u: np.ndarray, delay: float) -> np.ndarray:
-    """The held command seen through a transport delay [s]: the mean of u(t - delay) over each
-    sample interval, u held between stamps (exact for a zero-order hold, smooth in delay)."""
-    if delay <= 0.0:
-        return u
-    dt = np.diff(t)
-    area = np.concatenate([[0.0], np.cumsum(u[:-1] * dt)])
-    # area up to time s of the held command, u[0] before the start
-    tq = np.concatenate([t - delay, [t[-1] + dt[-1] - delay]])
-    a = np.interp(tq, t, area) + np.minimum(tq - t[0], 0.0) * u[0]
-    return np.diff(a) / np.concatenate([dt, [dt[-1]]])
+def applied_commands(model, rec: Record) -> np.ndarray:
+    """The mean command reaching the motor over each sample interval: the record's command through
+    the model's delay (:func:`~ipfric_core.physics.rig.delayed_means`), deadzone and saturation."""
+    tr = model.truth
+    u = np.ascontiguousarray(delayed_means(rec.t, rec.u, tr.input_delay_s), float)
+    return inputs_through(u, tr.deadzone_V, tr.saturation_V)
 
 
 @dataclass(frozen=True)
@@ -251,14 +249,15 @@ class Prediction:
 
 def predict(model, rec: Record, win: Windows) -> Prediction:
     """Replay ``rec``'s command through ``model`` (an :class:`ident.model.ModelVectors`)."""
-    u = np.ascontiguousarray(delayed(rec.t, rec.u, model.delay), float)
+    tr = model.truth
+    first, durations, commands = delayed_pieces(rec.t, rec.u, tr.input_delay_s)
     out = np.full((len(rec.t), 2), np.nan)
-    drive = tuple(float(v) for v in model.drive)
-    drive0 = (drive_states(model.pp, drive[0], drive[1], rec.t, inputs_through(u, model.deadzone, model.saturation),
-                           win.motion)[win.start] if drive[0] > 0.0 else np.zeros((len(win), 3)))
-    _shoot(model.pp, model.fp, model.ef, model.deadzone, model.saturation, model.gap, model.theta_bias,
-           drive, drive0, rec.t, u, win.start, win.stop, win.state, win.held,
-           min(1e-3, float(np.median(np.diff(rec.t)))), win.forced, out)
+    drive = tuple(float(v) for v in tr.drive_vector())
+    drive0 = (drive_states(model.pp, drive[0], drive[1], rec.t, applied_commands(model, rec), win.motion)[win.start]
+              if drive[0] > 0.0 else np.zeros((len(win), 3)))
+    _shoot(model.pp, model.fp, tr.force_vector(), tr.deadzone_V, tr.saturation_V, tr.backlash_m, tr.bias_theta_rad,
+           drive, drive0, rec.t, first, durations, np.ascontiguousarray(commands, float), win.start, win.stop,
+           win.state, win.held, min(1e-3, float(np.median(np.diff(rec.t)))), win.forced, out)
     window_of = np.full(len(rec.t), -1)
     for i, (a, b) in enumerate(zip(win.start, win.stop)):
         window_of[a + 1:b] = i

@@ -12,7 +12,8 @@ from dataclasses import dataclass
 
 from .compiled import compiled
 
-__all__ = ['delay_samples', 'filter_coefficient', 'filtered_rate', 'feedback', 'FeedbackSpec', 'StateFeedback']
+__all__ = ['delay_samples', 'gain_vector', 'filter_coefficient', 'filtered_rate', 'feedback', 'FeedbackSpec',
+           'StateFeedback']
 
 
 def delay_samples(tau: float, dt: float) -> int:
@@ -24,6 +25,22 @@ def delay_samples(tau: float, dt: float) -> int:
         raise ValueError(f'delay tau = {tau:g} s is not a multiple of the sample period '
                          f'{dt:g} s; allowed: n * {dt:g} s, e.g. {n * dt:g} s')
     return n
+
+
+def gain_vector(gain) -> tuple[float, float, float, float]:
+    """K as 4 finite floats on (x, theta, x', theta') [V/m, V/rad, V s/m, V s/rad], eq. (13); a 5th
+    entry, on the bristle state z, is accepted only as 0 (z is not measured). ValueError otherwise,
+    its message to be prefixed with the field's name."""
+    expected = f'expected 4 finite numbers (x, theta, x\', theta\') [V/m, V/rad, V s/m, V s/rad], got {gain!r}'
+    try:
+        k = [float(v) for v in gain]
+    except (TypeError, ValueError):
+        raise ValueError(expected) from None
+    if len(k) == 5 and k[4] != 0.0:
+        raise ValueError(f'entry 4 (the bristle state z) must be 0: z is not measured; got {gain!r}')
+    if len(k) not in (4, 5) or not all(math.isfinite(v) for v in k):
+        raise ValueError(expected)
+    return k[0], k[1], k[2], k[3]
 
 
 @compiled
@@ -76,14 +93,12 @@ class StateFeedback:
 
     def __init__(self, gain, dt: float, delay: float = 0.0, cutoff_hz: float = 20.0,
                  voltage_limit: float = math.inf):
-        gain = [float(k) for k in gain]
-        if len(gain) == 5 and gain[4] != 0.0:
-            raise ValueError('gain[4] (z): the bristle state is not measured; it must be 0')
-        if len(gain) not in (4, 5) or not all(math.isfinite(k) for k in gain):
-            raise ValueError(f'gain: expected 4 finite numbers (x, theta, x\', theta\'), got {gain}')
+        try:
+            self.gain = gain_vector(gain)
+        except ValueError as exc:
+            raise ValueError(f'gain: {exc}') from None
         if not dt > 0:
             raise ValueError(f'dt = {dt!r}: must be > 0')
-        self.gain = tuple(gain[:4])
         self.dt = dt
         self.cutoff_hz = float(cutoff_hz)
         self.voltage_limit = float(voltage_limit)

@@ -113,7 +113,7 @@ FRICTION_FIELDS = {
     'eps': Field('N s/m', 0.0, 1e3, 'viscous coefficient, eq. (3)/(7)'),
     'mu_s': Field('', 0.0, 2.0, 'static friction coefficient, eq. (5)'),
     'mu_c': Field('', 0.0, 2.0, 'Coulomb friction coefficient, eq. (6)'),
-    'v_s': Field('m/s', 0.0, 100.0, 'Stribeck velocity, eq. (8)', lo_open=True),
+    'v_s': Field('m/s', 0.0, 10.0, 'Stribeck velocity, eq. (8)', lo_open=True),
     'gamma': Field('', 0.0, 10.0, 'Stribeck form factor, eq. (8)', lo_open=True),
     'sigma0': Field('N/m', 0.0, 1e9, 'bristle stiffness, eq. (10)', lo_open=True),
     'sigma1': Field('N s/m', 0.0, 1e6, 'bristle damping, eq. (11)'),

@@ -104,15 +104,23 @@ def stuck_theta_acceleration(pp, theta: float) -> float:
 def undeclared_force(ef, x: float, v: float) -> float:
     """Force on the cart [N] fixed to the track, that the friction model does not declare.
 
-    ``ef`` = (cogging amplitude A [N], cogging period P [m], cogging phase phi [rad], offset
-    F0 [N]): A sin(2 pi x / P + phi) + F0 (motor cogging, screw ripple; a sloped track or an
-    amplifier offset). It acts at rest too. ``v`` is unused (the signature of a force law).
+    ``ef`` = (a [N], b [N], period P [m], offset F0 [N]): a sin(2 pi x / P) + b cos(2 pi x / P)
+    + F0 (motor cogging, screw ripple; a sloped track or an amplifier offset). It acts at rest
+    too. ``v`` is unused (the signature of a force law).
     """
-    f = ef[0] * math.sin(2 * math.pi * x / ef[1] + ef[2]) if ef[0] != 0.0 else 0.0
+    f = 0.0
+    if ef[0] != 0.0 or ef[1] != 0.0:
+        w = 2 * math.pi * x / ef[2]
+        f = ef[0] * math.sin(w) + ef[1] * math.cos(w)
     return f + ef[3]
 
 
-NO_EXTRA_FORCE = (0.0, 1.0, 0.0, 0.0)
+def cogging_amplitude_phase(a: float, b: float) -> tuple[float, float]:
+    """(A [N], phi [rad]) of a sin(w) + b cos(w) = A sin(w + phi)."""
+    return math.hypot(a, b), math.atan2(b, a)
+
+
+NO_EXTRA_FORCE = (0.0, 0.0, 1.0, 0.0)
 
 
 @compiled

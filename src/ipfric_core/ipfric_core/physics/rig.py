@@ -17,25 +17,50 @@ import numpy as np
 from ..constants import FALLEN, FALLEN_ANGLE_RAD, TRACK_LIMIT, TRACK_LIMIT_M
 from .compiled import compiled
 from .encoder import quantize
-from .params import FrictionParams
+from .params import Field, FrictionParams, check_keys, check_number
 from .plant import CartPendulum
 from .simulate import Simulator
 
 __all__ = ['PlantTruth', 'input_effects', 'inputs_through', 'play', 'sensor_reading', 'RigSpec', 'Rig']
 
 
+#: the schema of :class:`PlantTruth`: unit, range and meaning of every field (its default is the dataclass's)
+PLANT_TRUTH_FIELDS = {
+    'cogging_sin_N': Field('N', -100.0, 100.0, 'position-periodic force, coefficient of sin(2 pi x / P)'),
+    'cogging_cos_N': Field('N', -100.0, 100.0, 'position-periodic force, coefficient of cos(2 pi x / P)'),
+    'cogging_period_m': Field('m', 0.0, 10.0, 'period P of the position-periodic force', lo_open=True),
+    'offset_N': Field('N', -100.0, 100.0, 'constant force on the cart'),
+    'asymmetry': Field('', -0.9, 0.9, 'friction level (1 + a) forward, (1 - a) backward'),
+    'asymmetry_viscous_Ns_per_m': Field('N s/m', -100.0, 100.0, 'viscous coefficient + forward, - backward'),
+    'deadzone_V': Field('V', 0.0, 100.0, 'input deadzone'),
+    'saturation_V': Field('V', 0.0, 1e3, 'drive saturation (0 = none)'),
+    'input_delay_s': Field('s', 0.0, 10.0, 'transport delay of the command'),
+    'backlash_m': Field('m', 0.0, 1.0, 'play between cart and its encoder'),
+    'drive_backlash_m': Field('m', 0.0, 1.0, 'play between the motor side of the drive and the cart'),
+    'drive_mass_kg': Field('kg', 0.0, 100.0, 'motor side of the drive reflected to the rack (with a play)'),
+    'drive_stiffness_N_per_m': Field('N/m', 0.0, 1e6, 'stiffness of the drive\'s contact beyond its play'),
+    'drive_damping_Ns_per_m': Field('N s/m', 0.0, 1e3, 'damping of the drive\'s contact beyond its play'),
+    'bias_x_m': Field('m', -1.0, 1.0, 'cart sensor offset'),
+    'bias_theta_rad': Field('rad', -1.0, 1.0, 'angle sensor offset'),
+    'noise_x_m': Field('m', 0.0, 1.0, 'cart sensor noise (std)'),
+    'noise_theta_rad': Field('rad', 0.0, 1.0, 'angle sensor noise (std)'),
+    'noise_seed': Field('', 0, 2 ** 31 - 1, 'seed of the sensor noise', integer=True),
+}
+
+
 @dataclass(frozen=True)
 class PlantTruth:
-    """Undeclared effects (all 0 = off).
+    """Undeclared effects (all 0 = off); the schema of each field is :data:`PLANT_TRUTH_FIELDS`.
 
-    cogging_N, cogging_period_m, cogging_phase_rad : position-periodic force
-        A sin(2 pi x / P + phi) [N], [m], [rad]
+    cogging_sin_N, cogging_cos_N, cogging_period_m : position-periodic force
+        a sin(2 pi x / P) + b cos(2 pi x / P) [N], [N], [m] (:func:`cogging_amplitude_phase`)
     offset_N : constant force on the cart (a sloped track, an amplifier offset) [N]
     asymmetry : friction level (1 + a) forward, (1 - a) backward, static friction included
     asymmetry_viscous_Ns_per_m : viscous coefficient eps + dF_v forward, eps - dF_v backward
     deadzone_V : input deadzone; |V| below it gives no force, above it V - sgn(V) dz [V]
     saturation_V : the drive cannot apply more than this [V] (0 = no limit)
-    input_delay_s : transport delay of the command [s], a multiple of the sample period
+    input_delay_s : transport delay of the command [s] (:func:`delayed_pieces`); a rig runs
+        whole samples of it
     backlash_m : play between cart and its position encoder (rack and pinion) [m]
     drive_backlash_m : play between the motor side of the drive and the cart [m]; the motor
         side (rotor and gears reflected to the rack) crosses it without pushing the cart
@@ -48,9 +73,9 @@ class PlantTruth:
     noise_seed : seed of that noise
     """
 
-    cogging_N: float = 0.0
+    cogging_sin_N: float = 0.0
+    cogging_cos_N: float = 0.0
     cogging_period_m: float = 0.01
-    cogging_phase_rad: float = 0.0
     offset_N: float = 0.0
     asymmetry: float = 0.0
     asymmetry_viscous_Ns_per_m: float = 0.0
@@ -68,12 +93,21 @@ class PlantTruth:
     noise_theta_rad: float = 0.0
     noise_seed: int = 1
 
+    @classmethod
+    def from_dict(cls, data, path: str = 'plant_truth') -> PlantTruth:
+        """Validated against :data:`PLANT_TRUTH_FIELDS` (absent fields: off); errors name ``path.field``."""
+        data = check_keys(path, data, set(PLANT_TRUTH_FIELDS), set())
+        values: dict = {k: check_number(f'{path}.{k}', data[k], f) for k, f in PLANT_TRUTH_FIELDS.items() if k in data}
+        if 'noise_seed' in values:
+            values['noise_seed'] = int(values['noise_seed'])
+        return cls(**values)
+
     def to_dict(self) -> dict:
         return asdict(self)
 
     def force_vector(self) -> tuple:
         """The forces fixed to the track as ``plant.undeclared_force`` takes them."""
-        return (float(self.cogging_N), float(self.cogging_period_m), float(self.cogging_phase_rad),
+        return (float(self.cogging_sin_N), float(self.cogging_cos_N), float(self.cogging_period_m),
                 float(self.offset_N))
 
     def drive_vector(self) -> tuple:
@@ -108,6 +142,44 @@ def inputs_through(u, deadzone: float, saturation: float):
     for k in range(len(u)):
         out[k] = input_effects(u[k], deadzone, saturation)
     return out
+
+
+def delayed_pieces(t, u, delay: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The command as the drive applies it through a transport delay ``delay`` [s]: each command u_k
+    is held from its stamp t_k to the next and reaches the motor ``delay`` later, over
+    [t_k + delay, t_k+1 + delay) (before the first of them: u_0). Returns, per sample interval
+    [t_k, t_k+1), its pieces of constant applied command: ``first`` (n offsets: the pieces of
+    interval k are first[k] .. first[k+1] - 1, first[n-1] is their count), the pieces' durations
+    [s] and commands. Without a delay each interval is one piece, (t_k+1 - t_k, u_k); a delay of
+    whole samples on even stamps shifts the commands by those samples (the rig's FIFO, :class:`Rig`).
+    """
+    t, u = np.asarray(t, float), np.asarray(u, float)
+    n = len(t)
+    tol = 1e-9 * float(np.median(np.diff(t))) if n > 1 else 0.0
+    switches = t + delay
+    near = np.clip(np.searchsorted(t, switches), 0, n - 1)
+    for cand in (near, np.maximum(near - 1, 0)):
+        snap = np.abs(t[cand] - switches) <= tol
+        switches[snap] = t[cand][snap]
+    edges = np.union1d(t, switches[(switches > t[0]) & (switches < t[-1])])
+    starts = edges[:-1]
+    j = np.searchsorted(t, starts - delay + tol, side='right') - 1
+    values = u[np.maximum(j, 0)]
+    owner = np.searchsorted(t, starts + tol, side='right') - 1
+    first = np.searchsorted(owner, np.arange(n))
+    return first, np.diff(edges), values
+
+
+def delayed_means(t, u, delay: float) -> np.ndarray:
+    """The mean command the drive applies over each sample interval through a transport delay
+    (:func:`delayed_pieces`); at the last sample, the command applied there. Without a delay: ``u``."""
+    u = np.asarray(u, float)
+    if delay <= 0.0:
+        return u
+    first, durations, values = delayed_pieces(t, u, delay)
+    means = np.add.reduceat(durations * values, first[:-1]) / np.add.reduceat(durations, first[:-1])
+    last = np.searchsorted(t, t[-1] - delay, side='right') - 1
+    return np.concatenate([means, [u[max(last, 0)]]])
 
 
 def apply_input_effects(voltage: float, truth: PlantTruth) -> float:

@@ -37,7 +37,7 @@ def demo(config: str | Path = DEFAULT_SCENARIO, out: str | Path | None = None, d
         raise
     if res.exit_code != 0:
         return res, None
-    summary = {'run': res.to_dict(), 'analysis': analyze_run(out, out / 'plots')}
+    summary: dict = {'run': res.to_dict(), 'analysis': analyze_run(out, out / 'plots')}
     (out / 'analysis.json').write_text(json.dumps(summary, indent=2, default=float))
     summary['file'] = str(out / 'analysis.json')
     return res, summary

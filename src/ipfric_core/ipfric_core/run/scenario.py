@@ -45,7 +45,7 @@ from typing import Any
 
 from ..constants import ANGLE_RESOLUTION_RAD, CART_RESOLUTION_M, FALLEN_ANGLE_RAD, REPO_ROOT, TRACK_LIMIT_M
 from ..design.lqr import CONTROL_WEIGHT, STATE_WEIGHT, design
-from ..physics.controller import StateFeedback, delay_samples
+from ..physics.controller import StateFeedback, delay_samples, gain_vector
 from ..physics.params import (
     FRICTION_FIELDS,
     FRICTION_MODELS,
@@ -61,7 +61,7 @@ from ..physics.params import (
     load_yaml,
 )
 from ..physics.plant import CartPendulum
-from ..physics.rig import PlantTruth, Rig
+from ..physics.rig import PLANT_TRUTH_FIELDS, PlantTruth, Rig
 
 __all__ = ['DEFAULT_SCENARIO', 'Scenario', 'nest', 'scenario_from_ros_params', 'load_scenario']
 
@@ -71,47 +71,23 @@ TIME_MODES = ('lockstep', 'realtime')
 GAIN_SOURCES = ('yaml', 'design')
 
 SIM_FIELDS = {
-    'sample_rate_hz': (1000.0, Field('Hz', 1.0, 1e5, 'sample rate of encoders and commands')),
-    'duration': (20.0, Field('s', 0.0, 1e6, 'simulated run length, 0 = until stopped')),
-    'lockstep_timeout_s': (1.0, Field('s', 0.0, 60.0, 'lockstep: wall time to wait for a command',
-                                      lo_open=True)),
-    'watchdog_samples': (50, Field('samples', 1, 1e6, 'samples without a valid command before V = 0',
-                                   integer=True)),
-    'voltage_max': (10.0, Field('V', 0.0, 1e3, 'largest accepted command', lo_open=True)),
-    'theta0': (0.02, Field('rad', -1.0, 1.0, 'initial angle from upright, eq. (30)')),
-    'track_limit': (TRACK_LIMIT_M, Field('m', 0.0, 10.0, 'end the run beyond |x|', lo_open=True)),
-    'fallen_angle': (FALLEN_ANGLE_RAD, Field('rad', 0.0, math.pi, 'end the run beyond |theta|',
-                                               lo_open=True)),
-    'cart_resolution': (CART_RESOLUTION_M, Field('m', 0.0, 1.0, 'cart encoder count (0 = exact)')),
-    'angle_resolution': (ANGLE_RESOLUTION_RAD, Field('rad', 0.0, 1.0, 'angle encoder count (0 = exact)')),
-}
-PLANT_TRUTH_FIELDS = {
-    'cogging_N': Field('N', -100.0, 100.0, 'amplitude of the position-periodic force'),
-    'cogging_period_m': Field('m', 0.0, 10.0, 'period of the cogging force', lo_open=True),
-    'cogging_phase_rad': Field('rad', -10.0, 10.0, 'phase of the cogging force at x = 0'),
-    'offset_N': Field('N', -100.0, 100.0, 'constant force on the cart'),
-    'asymmetry': Field('', -0.9, 0.9, 'friction level (1 + a) forward, (1 - a) backward'),
-    'asymmetry_viscous_Ns_per_m': Field('N s/m', -100.0, 100.0, 'viscous coefficient + forward, - backward'),
-    'deadzone_V': Field('V', 0.0, 100.0, 'input deadzone'),
-    'saturation_V': Field('V', 0.0, 1e3, 'drive saturation (0 = none)'),
-    'input_delay_s': Field('s', 0.0, 10.0, 'transport delay of the command'),
-    'backlash_m': Field('m', 0.0, 1.0, 'play between cart and its encoder'),
-    'drive_backlash_m': Field('m', 0.0, 1.0, 'play between the motor side of the drive and the cart'),
-    'drive_mass_kg': Field('kg', 0.0, 100.0, 'motor side of the drive reflected to the rack (with a play)'),
-    'drive_stiffness_N_per_m': Field('N/m', 0.0, 1e9, 'stiffness of the drive\'s contact beyond its play'),
-    'drive_damping_Ns_per_m': Field('N s/m', 0.0, 1e6, 'damping of the drive\'s contact beyond its play'),
-    'bias_x_m': Field('m', -1.0, 1.0, 'cart sensor offset'),
-    'bias_theta_rad': Field('rad', -1.0, 1.0, 'angle sensor offset'),
-    'noise_x_m': Field('m', 0.0, 1.0, 'cart sensor noise (std)'),
-    'noise_theta_rad': Field('rad', 0.0, 1.0, 'angle sensor noise (std)'),
-    'noise_seed': Field('', 0, 2 ** 31 - 1, 'seed of the sensor noise', integer=True),
+    'sample_rate_hz': Field('Hz', 1.0, 1e5, 'sample rate of encoders and commands'),
+    'duration': Field('s', 0.0, 1e6, 'simulated run length, 0 = until stopped'),
+    'lockstep_timeout_s': Field('s', 0.0, 60.0, 'lockstep: wall time to wait for a command', lo_open=True),
+    'watchdog_samples': Field('samples', 1, 1e6, 'samples without a valid command before V = 0', integer=True),
+    'voltage_max': Field('V', 0.0, 1e3, 'largest accepted command', lo_open=True),
+    'theta0': Field('rad', -1.0, 1.0, 'initial angle from upright, eq. (30)'),
+    'track_limit': Field('m', 0.0, 10.0, 'end the run beyond |x|', lo_open=True),
+    'fallen_angle': Field('rad', 0.0, math.pi, 'end the run beyond |theta|', lo_open=True),
+    'cart_resolution': Field('m', 0.0, 1.0, 'cart encoder count (0 = exact)'),
+    'angle_resolution': Field('rad', 0.0, 1.0, 'angle encoder count (0 = exact)'),
 }
 CONTROLLER_FIELDS = {
-    'sample_rate_hz': (1000.0, SIM_FIELDS['sample_rate_hz'][1]),
-    'delay': (0.0, Field('s', 0.0, 10.0, 'artificial feedback delay tau, eq. (26), a multiple of the sample period')),
-    'cutoff_hz': (20.0, Field('Hz', 0.0, 1e4, 'velocity filter corner (0 = raw difference)')),
-    'voltage_limit': (10.0, Field('V', 0.0, 1e3, 'command saturation', lo_open=True)),
-    'R': (1.0, CONTROL_WEIGHT),
+    'sample_rate_hz': SIM_FIELDS['sample_rate_hz'],
+    'delay': Field('s', 0.0, 10.0, 'artificial feedback delay tau, eq. (26), a multiple of the sample period'),
+    'cutoff_hz': Field('Hz', 0.0, 1e4, 'velocity filter corner (0 = raw difference)'),
+    'voltage_limit': Field('V', 0.0, 1e3, 'command saturation', lo_open=True),
+    'R': CONTROL_WEIGHT,
 }
 DEFAULT_Q = [5000.0, 3000.0, 20.0, 20.0]
 GAIN = Field('V per SI unit', -1e6, 1e6, 'state feedback gain')
@@ -147,13 +123,11 @@ class ControllerSettings:
 
 
 def _gain(path: str, value: Any) -> tuple:
-    if not isinstance(value, (list, tuple)) or len(value) not in (4, 5):
-        raise ConfigError(f'{path}: expected 4 numbers (x, theta, x\', theta\') [V/m, V/rad, V s/m, V s/rad], '
-                          f'got {value!r}')
-    g = tuple(check_number(f'{path}[{i}]', v, GAIN) for i, v in enumerate(value))
-    if len(g) == 5 and g[4] != 0.0:
-        raise ConfigError(f'{path}[4]: the bristle state z is not measured; its gain must be 0')
-    return g[:4]
+    try:
+        gain = gain_vector(value if isinstance(value, (list, tuple)) else [value])
+    except ValueError as exc:
+        raise ConfigError(f'{path}: {exc}') from None
+    return tuple(check_number(f'{path}[{i}]', v, GAIN) for i, v in enumerate(gain))
 
 
 def parse_sim(data: Mapping, path: str = 'sim_node.ros__parameters'):
@@ -161,19 +135,14 @@ def parse_sim(data: Mapping, path: str = 'sim_node.ros__parameters'):
     known = set(SIM_FIELDS) | {'time_mode', 'plant', 'friction', 'plant_truth', 'use_sim_time'}
     data = check_keys(path, data, known, {'plant', 'friction'})
     values: dict[str, Any] = {k: check_number(f'{path}.{k}', data[k], spec)
-                              for k, (_, spec) in SIM_FIELDS.items() if k in data}
+                              for k, spec in SIM_FIELDS.items() if k in data}
     if 'watchdog_samples' in values:
         values['watchdog_samples'] = int(values['watchdog_samples'])
     values['time_mode'] = check_choice(f'{path}.time_mode', data.get('time_mode', 'lockstep'), TIME_MODES)
     sim = SimSettings(**values)
     plant = PlantParams.from_dict(data['plant'], f'{path}.plant')
     friction = FrictionParams.from_dict(data['friction'], f'{path}.friction')
-    tdata = check_keys(f'{path}.plant_truth', data.get('plant_truth', {}) or {}, set(PLANT_TRUTH_FIELDS), set())
-    tvals: dict[str, Any] = {k: check_number(f'{path}.plant_truth.{k}', tdata[k], s)
-                             for k, s in PLANT_TRUTH_FIELDS.items() if k in tdata}
-    if 'noise_seed' in tvals:
-        tvals['noise_seed'] = int(tvals['noise_seed'])
-    truth = PlantTruth(**tvals)
+    truth = PlantTruth.from_dict(data.get('plant_truth', {}) or {}, f'{path}.plant_truth')
     dt = 1.0 / sim.sample_rate_hz
     try:
         delay_samples(truth.input_delay_s, dt)
@@ -191,7 +160,7 @@ def parse_controller(data: Mapping, path: str = 'controller_node.ros__parameters
     known = set(CONTROLLER_FIELDS) | {'gain_source', 'gain', 'plant', 'design_friction', 'Q', 'use_sim_time'}
     data = check_keys(path, data, known, set())
     values: dict[str, Any] = {k: check_number(f'{path}.{k}', data[k], spec)
-              for k, (_, spec) in CONTROLLER_FIELDS.items() if k in data}
+              for k, spec in CONTROLLER_FIELDS.items() if k in data}
     source = check_choice(f'{path}.gain_source', data.get('gain_source', 'yaml'), GAIN_SOURCES)
     gain = design_friction = None
     plant = PlantParams.from_dict(data['plant'], f'{path}.plant') if 'plant' in data else PlantParams()
@@ -290,16 +259,16 @@ class Scenario:
                 num(f'{prefix}.{k}', getattr(PlantParams(), k), spec)
 
         if node == 'sim_node':
-            for k, (default, spec) in SIM_FIELDS.items():
-                num(k, default, spec)
+            for k, spec in SIM_FIELDS.items():
+                num(k, getattr(SimSettings(), k), spec)
             out['time_mode'] = ('lockstep', 'lockstep | realtime', None)
             plant('plant')
             friction('friction', FrictionParams())
             for f in fields(PlantTruth):
                 num(f'plant_truth.{f.name}', f.default, PLANT_TRUTH_FIELDS[f.name])
         elif node == 'controller_node':
-            for k, (default, spec) in CONTROLLER_FIELDS.items():
-                num(k, default, spec)
+            for k, spec in CONTROLLER_FIELDS.items():
+                num(k, getattr(ControllerSettings(), k), spec)
             out['gain_source'] = ('yaml', 'where the gain comes from: yaml | design', None)
             out['gain'] = ([0.0, 0.0, 0.0, 0.0], 'V = K (x, theta, x\', theta\') [V/m, V/rad, V s/m, V s/rad]', None)
             out['Q'] = (list(DEFAULT_Q), 'LQR weights on (x, theta, x\', theta\')', None)

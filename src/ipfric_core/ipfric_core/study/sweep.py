@@ -274,7 +274,8 @@ def figure_study(figure: str, taus, duration: float, out: str | Path, sensors: s
     name, variants = FIGURES[figure]
     config = figure_config(figure)
     out = Path(out)
-    panels, result = [], {'figure_of_paper': figure, 'config': str(config), 'variants': {}}
+    panels: list[dict] = []
+    result: dict = {'figure_of_paper': figure, 'config': str(config), 'variants': {}}
     for gname, trange in FIGURE_GRIDS:
         ths = parse_range(trange)
         panel: dict = {'title': f'θ0 {ths[0]:g}-{ths[-1]:g} deg', 'taus': taus, 'thetas_deg': ths, 'curves': []}
