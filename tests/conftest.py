@@ -1,12 +1,12 @@
-import sys
+"""What every test shares: the ``ros`` marker of tests/ros, the paper's configuration, the shared data
+(skipped when absent). ipfric_core is installed in the environment (editable, by scripts/setup.sh)."""
 from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / 'src' / 'ipfric_core'))
+from ipfric_core.design.paperconfig import DEFAULT_DATA, load_paper_config
 
-from ipfric_core.design.paperconfig import DEFAULT_DATA, load_paper_config  # noqa: E402
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def pytest_collection_modifyitems(items):

@@ -10,11 +10,15 @@ setup(
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
         ('share/' + package_name, ['package.xml']),
     ],
-    install_requires=['setuptools', 'numpy', 'scipy', 'pyyaml'],
+    # what the core imports (versions pinned in the checkout's requirements.txt)
+    install_requires=['setuptools', 'numpy', 'scipy', 'pyyaml', 'numba', 'control', 'matplotlib', 'mcap',
+                      'mcap-ros2-support', 'zstandard', 'lz4'],
+    # --scheduler ADDRESS: sweeps, Monte Carlo and continuation on a Dask cluster
+    extras_require={'cluster': ['dask', 'distributed']},
     zip_safe=True,
     maintainer='ipfric maintainers',
     maintainer_email='maintainers@ipfric.org',
-    description='Physics and design core of ipfric (no ROS).',
+    description='Physics, design, run supervision, studies, analysis and identification of ipfric (no ROS).',
     license='Apache-2.0',
     entry_points={'console_scripts': []},
 )

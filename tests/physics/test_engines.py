@@ -1,20 +1,18 @@
 """The compiled closed-loop engine against the python engine (same scalar physics) and
 against an independent scipy solve_ivp (LSODA, event-located stick-slip) reference."""
 import math
-import sys
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from bench.scipy_reference import run_scipy
 from ipfric_core.physics.closedloop import run_closed_loop
 from ipfric_core.physics.rig import PlantTruth
 from ipfric_core.run.scenario import load_scenario
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))
-from bench.scipy_reference import run_scipy  # noqa: E402
 
 FIELDS = ('t', 'state', 'measured', 'voltage', 'friction', 'stuck')
 EFFECTS = PlantTruth(cogging_sin_N=0.0877583, cogging_cos_N=0.0479426, cogging_period_m=0.02, deadzone_V=0.1,

@@ -28,7 +28,7 @@ from .simulate import advance, friction_now
 
 __all__ = ['Trajectory', 'run_closed_loop', 'warm_up', 'LS_MODE', 'LS_APPLIED', 'LS_HELD', 'LS_PLAY', 'LS_LAST',
            'LS_RATE', 'LS_TIME', 'LS_HISTORY', 'loop_start', 'controller_sample', 'drive_command', 'plant_segment',
-           'limit_code']
+           'limit_code', 'LS_PLANT']
 
 ENGINES = ('auto', 'python', 'compiled')
 #: how an offline run ends, by the compiled engine's code 0, 1, 2

@@ -16,6 +16,7 @@ from typing import Any
 import yaml
 
 __all__ = ['FRICTION_MODELS', 'SMOOTHING', 'ConfigError', 'Field', 'check_number', 'check_choice', 'check_keys',
+           'check_fields',
            'PLANT_FIELDS', 'PlantParams', 'FRICTION_FIELDS', 'FrictionParams', 'load_yaml']
 
 FRICTION_MODELS = ('viscous', 'coulomb', 'exponential', 'dynamic')
@@ -46,8 +47,9 @@ def check_number(path: str, value: Any, spec: Field) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ConfigError(f'{path}: expected a number in {spec.describe()} ({spec.doc}), '
                           f'got {type(value).__name__} {value!r}')
-    if spec.integer and int(value) != value:
-        raise ConfigError(f'{path}: expected an integer in {spec.describe()}, got {value!r}')
+    if spec.integer and not isinstance(value, int):
+        raise ConfigError(f'{path}: expected an integer in {spec.describe()} (written without a decimal point, '
+                          f'as the ROS parameter is an integer), got {value!r}')
     v = float(value)
     if not math.isfinite(v):
         raise ConfigError(f'{path}: {value!r} is not finite; allowed {spec.describe()}')
@@ -77,6 +79,14 @@ def check_keys(path: str, data: Any, known: set[str], required: set[str]) -> Map
     return data
 
 
+def check_fields(path: str, data: Any, fields: Mapping[str, Field], required=()) -> dict:
+    """The numbers of mapping ``data`` checked against the schema ``fields`` (name -> Field): no unknown
+    key, every ``required`` one present, each value in its range; integers as int."""
+    data = check_keys(path, data, set(fields), set(required))
+    return {k: (int if f.integer else float)(check_number(f'{path}.{k}', data[k], f))
+            for k, f in fields.items() if k in data}
+
+
 PLANT_FIELDS = {
     'M': Field('kg', 0.0, 1e3, 'cart mass', lo_open=True),
     'm': Field('kg', 0.0, 1e3, 'pendulum mass', lo_open=True),
@@ -100,8 +110,7 @@ class PlantParams:
 
     @classmethod
     def from_dict(cls, data: Any, path: str = 'plant') -> PlantParams:
-        data = check_keys(path, data, set(PLANT_FIELDS), set(PLANT_FIELDS))
-        return cls(**{k: check_number(f'{path}.{k}', data[k], s) for k, s in PLANT_FIELDS.items()})
+        return cls(**check_fields(path, data, PLANT_FIELDS, PLANT_FIELDS))
 
     @property
     def normal_force(self) -> float:

@@ -20,7 +20,7 @@ from .params import FrictionParams, PlantParams
 
 __all__ = ['plant_vector', 'motor_force', 'held_force', 'required_forces', 'held_forces', 'pendulum_residuals',
            'stuck_theta_acceleration', 'undeclared_force', 'NO_EXTRA_FORCE', 'motor_side_free', 'drive_contact_force',
-           'undeclared_forces', 'rates', 'CartPendulum']
+           'undeclared_forces', 'rates', 'CartPendulum', 'cogging_amplitude_phase']
 
 # Positions in the plant vector.
 M, MP, L, G, ALPHA, BETA = range(6)

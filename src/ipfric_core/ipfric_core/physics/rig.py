@@ -17,11 +17,12 @@ import numpy as np
 from ..constants import FALLEN, FALLEN_ANGLE_RAD, TRACK_LIMIT, TRACK_LIMIT_M
 from .compiled import compiled
 from .encoder import quantize
-from .params import Field, FrictionParams, check_keys, check_number
+from .params import Field, FrictionParams, check_fields
 from .plant import CartPendulum
 from .simulate import Simulator
 
-__all__ = ['PlantTruth', 'input_effects', 'inputs_through', 'play', 'sensor_reading', 'RigSpec', 'Rig']
+__all__ = ['PlantTruth', 'input_effects', 'inputs_through', 'play', 'sensor_reading', 'RigSpec', 'Rig',
+           'PLANT_TRUTH_FIELDS', 'delayed_pieces', 'delayed_means']
 
 
 #: the schema of :class:`PlantTruth`: unit, range and meaning of every field (its default is the dataclass's)
@@ -96,11 +97,7 @@ class PlantTruth:
     @classmethod
     def from_dict(cls, data, path: str = 'plant_truth') -> PlantTruth:
         """Validated against :data:`PLANT_TRUTH_FIELDS` (absent fields: off); errors name ``path.field``."""
-        data = check_keys(path, data, set(PLANT_TRUTH_FIELDS), set())
-        values: dict = {k: check_number(f'{path}.{k}', data[k], f) for k, f in PLANT_TRUTH_FIELDS.items() if k in data}
-        if 'noise_seed' in values:
-            values['noise_seed'] = int(values['noise_seed'])
-        return cls(**values)
+        return cls(**check_fields(path, data, PLANT_TRUTH_FIELDS))
 
     def to_dict(self) -> dict:
         return asdict(self)

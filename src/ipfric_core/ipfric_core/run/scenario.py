@@ -56,6 +56,7 @@ from ..physics.params import (
     FrictionParams,
     PlantParams,
     check_choice,
+    check_fields,
     check_keys,
     check_number,
     load_yaml,
@@ -134,10 +135,7 @@ def parse_sim(data: Mapping, path: str = 'sim_node.ros__parameters'):
     """(SimSettings, PlantParams, FrictionParams, PlantTruth) from a nested mapping."""
     known = set(SIM_FIELDS) | {'time_mode', 'plant', 'friction', 'plant_truth', 'use_sim_time'}
     data = check_keys(path, data, known, {'plant', 'friction'})
-    values: dict[str, Any] = {k: check_number(f'{path}.{k}', data[k], spec)
-                              for k, spec in SIM_FIELDS.items() if k in data}
-    if 'watchdog_samples' in values:
-        values['watchdog_samples'] = int(values['watchdog_samples'])
+    values: dict[str, Any] = check_fields(path, {k: v for k, v in data.items() if k in SIM_FIELDS}, SIM_FIELDS)
     values['time_mode'] = check_choice(f'{path}.time_mode', data.get('time_mode', 'lockstep'), TIME_MODES)
     sim = SimSettings(**values)
     plant = PlantParams.from_dict(data['plant'], f'{path}.plant')
@@ -159,8 +157,8 @@ def parse_sim(data: Mapping, path: str = 'sim_node.ros__parameters'):
 def parse_controller(data: Mapping, path: str = 'controller_node.ros__parameters') -> ControllerSettings:
     known = set(CONTROLLER_FIELDS) | {'gain_source', 'gain', 'plant', 'design_friction', 'Q', 'use_sim_time'}
     data = check_keys(path, data, known, set())
-    values: dict[str, Any] = {k: check_number(f'{path}.{k}', data[k], spec)
-              for k, spec in CONTROLLER_FIELDS.items() if k in data}
+    values: dict[str, Any] = check_fields(path, {k: v for k, v in data.items() if k in CONTROLLER_FIELDS},
+                                          CONTROLLER_FIELDS)
     source = check_choice(f'{path}.gain_source', data.get('gain_source', 'yaml'), GAIN_SOURCES)
     gain = design_friction = None
     plant = PlantParams.from_dict(data['plant'], f'{path}.plant') if 'plant' in data else PlantParams()
