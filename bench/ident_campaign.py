@@ -141,7 +141,7 @@ def identify_case(case_dir: Path, truth: dict, timeout: float = TIMEOUT) -> dict
 
 
 # ------------------------------------------------------------------------------------- scoring
-def score_case(truth: dict, ident: dict, threshold: float = THRESHOLD) -> dict:
+def score_case(truth: dict, ident: dict, threshold: float = THRESHOLD, generation_s: float | None = None) -> dict:
     exp = expected_answer(truth, threshold)
     pred = predicted_answer(ident.get('result'))
     res = ident.get('result') or {}
@@ -153,7 +153,8 @@ def score_case(truth: dict, ident: dict, threshold: float = THRESHOLD) -> dict:
         components=components(truth), expected=exp['label'], expected_detail=exp,
         predicted=pred['label'], added=pred['added'], verdict=pred['verdict'],
         outcome=outcome(exp, pred), validation_counts=ladder, wall_s=ident.get('wall_s'),
-        generation_s=truth.get('generation_s'), rc=ident.get('rc'), stderr_tail=ident.get('stderr_tail'),
+        generation_s=generation_s if generation_s is not None else truth.get('generation_s'),
+        rc=ident.get('rc'), stderr_tail=ident.get('stderr_tail'),
         command=ident.get('command'))
 
 
@@ -238,7 +239,8 @@ def write_markdown(s: dict, path: Path) -> None:
           f'({_fmt(None if cl["share_anything_added"] is None else 100 * cl["share_anything_added"])} %) '
           f'{cl["added"] or ""}; declared not explained: {cl["not_explained"]}.', '',
           '## Per effect', '',
-          '| effect | cases | at/above threshold | named (above) | detection limit [counts] | answered instead (above) |',
+          '| effect | cases | at/above threshold | named (above) | detection limit [counts] '
+          '| answered instead (above) |',
           '|---|---|---|---|---|---|']
     for name, r in s['per_effect'].items():
         L.append(f'| {name} | {r["n"]} | {r["n_above"]} | {r["named_above"]} | '
@@ -329,7 +331,7 @@ def run_campaign(out_dir, n_cases, seed, workers=1, progress=None, threshold=THR
         truth = json.loads((d / 'truth.json').read_text())
         ident = identify_case(d, truth, timeout)
         (d / 'ident' / 'meta.json').write_text(json.dumps({k: v for k, v in ident.items() if k != 'result'}))
-        return score_case(truth, ident, threshold)
+        return score_case(truth, ident, threshold, manifest['generation_s'].get(name))
 
     cases = []
     if workers > 1:
@@ -354,6 +356,9 @@ def rescore(out_dir, threshold=THRESHOLD) -> dict:
     """Score the identifications already in out_dir again (another threshold, a changed scorer)."""
     out_dir = Path(out_dir)
     cases = []
+    gen = {}
+    if (out_dir / 'cases' / 'manifest.json').exists():
+        gen = json.loads((out_dir / 'cases' / 'manifest.json').read_text()).get('generation_s', {})
     for d in sorted((out_dir / 'cases').glob('case*')):
         truth = json.loads((d / 'truth.json').read_text())
         meta_p, res_p = d / 'ident' / 'meta.json', d / 'ident' / 'result.json'
@@ -361,7 +366,7 @@ def rescore(out_dir, threshold=THRESHOLD) -> dict:
             continue
         ident = json.loads(meta_p.read_text())
         ident['result'] = json.loads(res_p.read_text()) if ident.get('rc') == 0 and res_p.exists() else None
-        cases.append(score_case(truth, ident, threshold))
+        cases.append(score_case(truth, ident, threshold, gen.get(d.name)))
     old = {}
     if (out_dir / 'summary.json').exists():
         old = json.loads((out_dir / 'summary.json').read_text()).get('meta', {})

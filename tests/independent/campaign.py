@@ -49,7 +49,8 @@ in cart encoder counts (unrounded). With a pendulum its angle and rate follow th
 inside the windows (cubic Hermite between samples; an upright pendulum replayed free would
 diverge within a window). ``replay_self_error_counts_rms``: the replay with every effect against
 the true motion (about 1e-3 count; larger only where the motion is chaotic, e.g. a drive play's
-contact knocked at every reversal of a balancing controller). sensor_bias: the difference of the angle readings, in angle counts.
+contact knocked at every reversal of a balancing controller). sensor_bias: the difference of
+the angle readings, in angle counts.
 A declared plant constant made wrong (``plant_error``) gets its contribution the same way (the
 declared constant against the true one).
 
@@ -62,7 +63,6 @@ generate(out_dir, n_cases, seed, indices=None, workers=1) -> manifest.
 import argparse
 import json
 import math
-import os
 import time
 from pathlib import Path
 
@@ -627,7 +627,8 @@ def draw_case(seed, index, attempt=0):
         spec["controller"] = dict(
             Q=Q, r=1.0, eps_design=rig["eps"] * float(rng.uniform(0.5, 1.5)),
             estimator=est, filter_Hz=float(rng.uniform(10.0, 50.0)), alpha_beta=[aba, aba * aba / (2 - aba)],
-            voltage_limit_V=float(rng.uniform(5.0, 12.0)), theta0_rad=float(rng.choice([-1, 1]) * rng.uniform(0.01, 0.05)),
+            voltage_limit_V=float(rng.uniform(5.0, 12.0)),
+            theta0_rad=float(rng.choice([-1, 1]) * rng.uniform(0.01, 0.05)),
             excitation=exc, setpoint_m=float(rng.uniform(0.02, 0.08)), setpoint_period_s=float(rng.uniform(4.0, 10.0)),
             dither=_multisine(rng, rig["Fs"] / rig["alpha"] * float(rng.uniform(0.2, 0.8))))
     else:
@@ -843,12 +844,14 @@ def _jsonable(o):
     return o
 
 
-def make_case(seed, index):
+def make_case(seed, index, duration=None):
     """(data, truth) of case (seed, index): redrawn (attempt + 1) while a run leaves the track,
-    its pendulum falls or nothing moves."""
+    its pendulum falls or nothing moves. ``duration`` [s] overrides the drawn one (tests)."""
     reasons = []
     for attempt in range(MAX_ATTEMPTS):
         spec = draw_case(seed, index, attempt)
+        if duration is not None:
+            spec["duration"] = float(duration)
         data = simulate(spec)
         if data["end"] != "duration":
             reasons.append(f"attempt {attempt}: {data['end']} at t = {data['t'][-1]:.2f} s")
@@ -889,7 +892,7 @@ def make_case(seed, index):
         motion=dict(x_ptp_m=float(np.ptp(Y[:, 0])), max_abs_x_m=float(np.abs(Y[:, 0]).max()),
                     max_speed_mps=float(np.abs(Y[:, 1]).max()),
                     theta_ptp_rad=float(np.ptp(Y[:, 2])) if spec["pendulum_attached"] else None),
-        generator="tests/independent/campaign.py v%d" % VERSION)
+        generator=f"tests/independent/campaign.py v{VERSION}")
     return data, _jsonable(truth)
 
 
@@ -897,10 +900,11 @@ def case_name(index):
     return f"case{int(index):04d}"
 
 
-def write_case(out_dir, seed, index):
-    """Write DIR/<case>/data.csv, plant.yaml, truth.json; return the truth."""
+def write_case(out_dir, seed, index, duration=None):
+    """Write DIR/<case>/data.csv, plant.yaml, truth.json (the same bytes for the same (seed,
+    index)); return the truth with ``generation_s`` (not written) added."""
     t0 = time.perf_counter()
-    data, truth = make_case(seed, index)
+    data, truth = make_case(seed, index, duration)
     d = Path(out_dir) / truth["case"]
     d.mkdir(parents=True, exist_ok=True)
     cols = [data["t"], data["x"], data["voltage"]] + ([] if data["theta"] is None else [data["theta"]])
@@ -910,9 +914,8 @@ def write_case(out_dir, seed, index):
     (d / "plant.yaml").write_text(
         "# declared plant (friction: none given, the paper's exponential law is the hypothesis)\n"
         "plant: {" + ", ".join(f"{k}: {dp[k]!r}" for k in ("M", "m", "l", "g", "alpha", "beta")) + "}\n")
-    truth["generation_s"] = round(time.perf_counter() - t0, 3)
     (d / "truth.json").write_text(json.dumps(truth, indent=1, sort_keys=True))
-    return truth
+    return dict(truth, generation_s=round(time.perf_counter() - t0, 3))
 
 
 def _summary(truth):
@@ -925,17 +928,17 @@ def _summary(truth):
 
 
 def _worker(args):
-    out_dir, seed, index = args
-    truth = write_case(out_dir, seed, index)
+    out_dir, seed, index, duration = args
+    truth = write_case(out_dir, seed, index, duration)
     return _summary(truth), truth["generation_s"]
 
 
-def generate(out_dir, n_cases, seed, indices=None, workers=1, progress=None):
+def generate(out_dir, n_cases, seed, indices=None, workers=1, progress=None, duration=None):
     """Write cases (seed, i) for i in indices (default range(n_cases)) and DIR/manifest.json."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     indices = list(range(n_cases)) if indices is None else [int(i) for i in indices]
-    jobs = [(str(out_dir), int(seed), i) for i in indices]
+    jobs = [(str(out_dir), int(seed), i, duration) for i in indices]
     t0 = time.perf_counter()
     results = []
     if workers > 1:
