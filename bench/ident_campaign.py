@@ -140,8 +140,63 @@ def identify_case(case_dir: Path, truth: dict, timeout: float = TIMEOUT) -> dict
                 command='./ipfric ' + ' '.join(cmd))
 
 
+# ----------------------------------------------------------------------------------- the oracle
+def oracle_model_values(truth: dict) -> tuple[dict, list[tuple[str, dict]]]:
+    """The truth in the identification's own parameters: friction levels [N] and each library
+    effect with its values (effects from outside the library have no such parameters)."""
+    fr = truth['friction']
+    values = {'Fc': fr['Fc'], 'Fs_excess': fr['Fs_excess'], 'eps': fr['eps'], 'v_s': fr['v_s']}
+    effects = []
+    for name, q in sorted(truth['effects'].items()):
+        if name == 'deadzone':
+            effects.append((name, {'dz': q['dz_V']}))
+        elif name == 'saturation':
+            effects.append((name, {'u_max': q['u_max_V']}))
+        elif name == 'delay':
+            effects.append((name, {'delay': q['delay_s']}))
+        elif name == 'cogging':
+            a = q['amplitude_N']
+            effects.append((name, {'cog_a': a * math.cos(q['phase_rad']), 'cog_b': a * math.sin(q['phase_rad']),
+                                   'cog_period': q['period_m']}))
+        elif name == 'asymmetry':
+            effects.append((name, {'asym': q['a'], 'asym_v': 0.0}))
+        elif name == 'offset':
+            effects.append((name, {'F0': q['F0_N']}))
+        elif name == 'sensor_bias':
+            effects.append((name, {'theta_bias': q['theta_bias_rad']}))
+        elif name == 'drive_backlash':
+            effects.append((name, {'drive_gap': q['gap_m'], 'drive_mass': q['motor_mass_kg'],
+                                   'drive_stiffness': q['k_N_per_m'], 'drive_damping': q['c_N_s_per_m']}))
+    return values, effects
+
+
+def oracle(case_dir: Path, truth: dict, split: float = 0.6) -> dict:
+    """The identification's validation simulation error of the TRUE model (true constants, friction
+    and library effects; an outside effect left out): what its ladder could reach at best on this
+    file with its own loader and metric. Far above the encoders' rounding on a case whose effects
+    are all in the library, it says the data hold something the identification's model does not
+    represent (a hanging pendulum read as upright, a zeros angle column taken for a pendulum)."""
+    try:
+        from ipfric_core.ident.ladder import Problem
+        from ipfric_core.ident.model import load_declared
+        from ipfric_core.ident.records import load
+        from ipfric_core.physics.params import PlantParams
+        plant = PlantParams(**truth['constants'])
+        rec = load(case_dir / 'data.csv', plant, None, not truth['pendulum_attached'])
+        _, val = rec.split(split)
+        values, effects = oracle_model_values(truth)
+        model = load_declared(None, 'exponential', rec.theta is not None, plant).with_values(values)
+        for name, q in effects:
+            model = model.with_effect(name, q)
+        out = Problem(val).summary(model)
+        return {k: float(v) for k, v in out.items() if isinstance(v, (int, float))}
+    except Exception as exc:      # noqa: BLE001  (a refused file: the identification's message)
+        return {'error': f'{type(exc).__name__}: {exc}'}
+
+
 # ------------------------------------------------------------------------------------- scoring
-def score_case(truth: dict, ident: dict, threshold: float = THRESHOLD, generation_s: float | None = None) -> dict:
+def score_case(truth: dict, ident: dict, threshold: float = THRESHOLD, generation_s: float | None = None,
+               oracle_counts: dict | None = None) -> dict:
     exp = expected_answer(truth, threshold)
     pred = predicted_answer(ident.get('result'))
     res = ident.get('result') or {}
@@ -152,7 +207,8 @@ def score_case(truth: dict, ident: dict, threshold: float = THRESHOLD, generatio
         duration_s=truth['duration_s'], timing=truth['timing']['kind'],
         components=components(truth), expected=exp['label'], expected_detail=exp,
         predicted=pred['label'], added=pred['added'], verdict=pred['verdict'],
-        outcome=outcome(exp, pred), validation_counts=ladder, wall_s=ident.get('wall_s'),
+        outcome=outcome(exp, pred), validation_counts=ladder, oracle_counts=oracle_counts,
+        wall_s=ident.get('wall_s'),
         generation_s=generation_s if generation_s is not None else truth.get('generation_s'),
         rc=ident.get('rc'), stderr_tail=ident.get('stderr_tail'),
         command=ident.get('command'))
@@ -259,13 +315,20 @@ def write_markdown(s: dict, path: Path) -> None:
         for e in s['errors']:
             L.append(f'- {e["case"]} (exit {e["rc"]}): `{e["command"]}`: ' + ' / '.join(e['stderr_tail']))
         L.append('')
-    L += ['## Cases', '', '| case | experiment | theta | Ts [ms] | truth (counts) | expected | answer | outcome | '
-          'validation counts (declared -> refit -> final) | wall [s] |', '|---' * 10 + '|']
+    L += ['## Cases', '',
+          "Validation simulation error in the identification's metric (cart counts RMS); true model: the "
+          'same metric for the true constants, friction and library effects (an outside effect left out), '
+          'the best the ladder could reach.', '',
+          '| case | experiment | theta | Ts [ms] | truth (counts) | expected | answer | outcome | '
+          'validation counts (declared -> refit -> final) | true model | wall [s] |', '|---' * 11 + '|']
     for c in s['cases']:
         comp = ', '.join(f'{x["name"]} {x["counts"]:.3g}' for x in c['components']) or 'clean'
         val = ' -> '.join(f'{v:.3g}' for _, v in c['validation_counts'])
+        orc = c.get('oracle_counts') or {}
+        orc_s = 'refused' if 'error' in orc else _fmt(orc.get('x_rms_counts'))
         L.append(f'| {c["case"]} | {c["experiment"]} | {c["theta_column"]} | {1e3 * c["sample_period_s"]:.3g} | '
-                 f'{comp} | {c["expected"]} | {c["predicted"]} | {c["outcome"]} | {val} | {_fmt(c["wall_s"])} |')
+                 f'{comp} | {c["expected"]} | {c["predicted"]} | {c["outcome"]} | {val} | {orc_s} | '
+                 f'{_fmt(c["wall_s"])} |')
     path.write_text('\n'.join(L) + '\n')
 
 
@@ -313,9 +376,10 @@ def write_summary(out_dir: Path, cases: list[dict], threshold: float, meta: dict
 
 # ------------------------------------------------------------------------------------- driver
 def run_campaign(out_dir, n_cases, seed, workers=1, progress=None, threshold=THRESHOLD, indices=None,
-                 timeout=TIMEOUT, generate_workers=None) -> dict:
+                 timeout=TIMEOUT, generate_workers=None, with_oracle=True) -> dict:
     """Generate cases (seed, i), identify each (``workers`` identifications at a time), score;
-    returns the summary (also written to out_dir/summary.json, summary.md, detection.png)."""
+    returns the summary (also written to out_dir/summary.json, summary.md, detection.png).
+    ``with_oracle``: also the identification's error of the true model on each case (:func:`oracle`)."""
     out_dir = Path(out_dir)
     case_root = out_dir / 'cases'
     indices = list(range(n_cases)) if indices is None else list(indices)
@@ -330,8 +394,10 @@ def run_campaign(out_dir, n_cases, seed, workers=1, progress=None, threshold=THR
         d = case_root / name
         truth = json.loads((d / 'truth.json').read_text())
         ident = identify_case(d, truth, timeout)
-        (d / 'ident' / 'meta.json').write_text(json.dumps({k: v for k, v in ident.items() if k != 'result'}))
-        return score_case(truth, ident, threshold, manifest['generation_s'].get(name))
+        orc = oracle(d, truth) if with_oracle else None
+        (d / 'ident' / 'meta.json').write_text(json.dumps(
+            dict({k: v for k, v in ident.items() if k != 'result'}, oracle_counts=orc)))
+        return score_case(truth, ident, threshold, manifest['generation_s'].get(name), orc)
 
     cases = []
     if workers > 1:
@@ -352,8 +418,9 @@ def run_campaign(out_dir, n_cases, seed, workers=1, progress=None, threshold=THR
     return write_summary(out_dir, cases, threshold, meta)
 
 
-def rescore(out_dir, threshold=THRESHOLD) -> dict:
-    """Score the identifications already in out_dir again (another threshold, a changed scorer)."""
+def rescore(out_dir, threshold=THRESHOLD, with_oracle=False) -> dict:
+    """Score the identifications already in out_dir again (another threshold, a changed scorer);
+    ``with_oracle``: compute the true model's error where it is missing."""
     out_dir = Path(out_dir)
     cases = []
     gen = {}
@@ -366,7 +433,11 @@ def rescore(out_dir, threshold=THRESHOLD) -> dict:
             continue
         ident = json.loads(meta_p.read_text())
         ident['result'] = json.loads(res_p.read_text()) if ident.get('rc') == 0 and res_p.exists() else None
-        cases.append(score_case(truth, ident, threshold, gen.get(d.name)))
+        orc = ident.get('oracle_counts')
+        if orc is None and with_oracle:
+            orc = oracle(d, truth)
+            meta_p.write_text(json.dumps(dict({k: v for k, v in ident.items() if k != 'result'}, oracle_counts=orc)))
+        cases.append(score_case(truth, ident, threshold, gen.get(d.name), orc))
     old = {}
     if (out_dir / 'summary.json').exists():
         old = json.loads((out_dir / 'summary.json').read_text()).get('meta', {})
@@ -383,13 +454,14 @@ def main(argv=None) -> int:
     ap.add_argument('--workers', type=int, default=1, help='identifications at a time (default 1)')
     ap.add_argument('--timeout', type=float, default=TIMEOUT, help='seconds per identification')
     ap.add_argument('--rescore', action='store_true', help='score the results already in --out')
+    ap.add_argument('--no-oracle', action='store_true', help="skip the true model's error per case")
     a = ap.parse_args(argv)
     if a.rescore:
-        s = rescore(a.out, a.threshold)
+        s = rescore(a.out, a.threshold, not a.no_oracle)
     else:
         idx = [int(i) for i in a.indices.split(',')] if a.indices else None
         s = run_campaign(a.out, a.cases, a.seed, a.workers, lambda m: print(m, flush=True), a.threshold, idx,
-                         a.timeout)
+                         a.timeout, with_oracle=not a.no_oracle)
     print(Path(a.out) / 'summary.md')
     print(json.dumps({k: s[k] for k in ('outcomes', 'confusion', 'clean', 'timing')}, indent=1))
     return 0
