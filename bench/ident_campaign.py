@@ -256,6 +256,15 @@ def summarize(cases: list[dict], threshold: float, meta: dict) -> dict:
     walls = [c['wall_s'] for c in cases if c['wall_s'] is not None]
     gens = [c['generation_s'] for c in cases if c['generation_s'] is not None]
     outcomes = Counter(c['outcome'] for c in cases)
+    by_setting = {}
+    for key in sorted({(c['experiment'], c['theta_column']) for c in cases}):
+        sel = [c for c in cases if (c['experiment'], c['theta_column']) == key]
+        floors = [c['oracle_counts']['x_rms_counts'] for c in sel
+                  if c.get('oracle_counts') and 'x_rms_counts' in c['oracle_counts']]
+        by_setting[f'{key[0]} / {key[1]}'] = dict(
+            n=len(sel), right=sum(c['outcome'] in ('correct', 'acceptable') for c in sel),
+            outcomes=dict(Counter(c['outcome'] for c in sel)),
+            true_model_counts_median=float(np.median(floors)) if floors else None)
     return dict(
         meta=meta, threshold_counts=threshold, n_cases=len(cases), outcomes=dict(outcomes),
         right_share=(outcomes['correct'] + outcomes['acceptable']) / max(1, len(cases)),
@@ -264,7 +273,7 @@ def summarize(cases: list[dict], threshold: float, meta: dict) -> dict:
                    not_explained=sum(1 for c in clean if c['predicted'] == 'not_explained'),
                    share_anything_added=(sum(1 for c in clean if c['added']) / len(clean)) if clean else None,
                    added=dict(Counter(c['predicted'] for c in clean if c['added']))),
-        per_effect=rates,
+        per_effect=rates, by_setting=by_setting,
         timing=dict(identify_wall_s_mean=float(np.mean(walls)) if walls else None,
                     identify_wall_s_median=float(np.median(walls)) if walls else None,
                     identify_wall_s_max=float(np.max(walls)) if walls else None,
@@ -305,6 +314,14 @@ def write_markdown(s: dict, path: Path) -> None:
     L += ['', 'Detection rate against contribution (counts RMS; named / cases per bin):', '']
     for name, r in s['per_effect'].items():
         L.append(f'- {name}: ' + '; '.join(f'[{b["lo"]:g}, {b["hi"]:g}) {b["named"]}/{b["n"]}' for b in r['bins']))
+    L += ['', '## By experiment and angle column', '',
+          "True model: median over the cases of the identification's validation error of the true model "
+          '(the floor its ladder could reach).', '',
+          '| experiment / theta column | cases | right | outcomes | true model [counts], median |',
+          '|---|---|---|---|---|']
+    for k, v in s['by_setting'].items():
+        L.append(f'| {k} | {v["n"]} | {v["right"]} | ' + ', '.join(f'{a} {b}' for a, b in sorted(v['outcomes'].items()))
+                 + f' | {_fmt(v["true_model_counts_median"])} |')
     t = s['timing']
     L += ['', '## Time', '',
           f'Identification wall time per case: mean {_fmt(t["identify_wall_s_mean"])} s, median '
