@@ -54,6 +54,29 @@ the angle readings, in angle counts.
 A declared plant constant made wrong (``plant_error``) gets its contribution the same way (the
 declared constant against the true one).
 
+What is drawn (per case): the experiment (cart alone 50 %: ramps, steps with coast-downs,
+repositioning moves, pulses, multisines, no theta column or in 30 % a column of literal zeros;
+pendulum hanging 20 %: the same open-loop excitation, the angle read from hanging (~0), from
+upright (~pi) or from upright wrapped at +-pi; closed loop 30 %: LQR balancing upright with a gain
+of this module's own design (random Q, a guessed viscous coefficient), velocities by a filtered
+difference (10-50 Hz), a plain difference or an alpha-beta observer, clipped at 5-12 V, no
+excitation, a setpoint square wave or a voltage dither; the angle from upright or from hanging
+wrapped); the rig (M 0.2-2 kg, m, l, alpha 0.5-3 N/V, beta 1-12 N s/m, Fc 0.05-2 N, static excess,
+viscous eps, Stribeck velocity, encoders 1e-5..1e-4 m and 1024-4096 counts a turn); the effect
+(none 25 %, each library effect 7.5 %, spring and friction patch 7.5 % each; a second effect in
+8 % of the others), its size log-uniform from invisible to obvious; the sample period 1-10 ms,
+regular, jittered and/or with overruns (the stamp skips 2-3 periods, then 1-3 readings repeat);
+30-120 s; in 12 % one declared constant wrong by 10-40 % (truth ``plant_error``). A hanging
+pendulum may swing over the top (its angle then leaves +-pi around its rest): real logs do that.
+
+Files: DIR/<case>/data.csv (t, x, voltage[, theta]), plant.yaml (the declared plant), truth.json:
+``spec`` (every drawn value), ``effects`` (each effect's parameters in SI units, ``library``,
+``contribution_counts_rms`` over the record and its last 40 % ``..._validation``, the largest
+difference), ``contribution_counts_rms`` (name -> counts), ``plant_error``, ``constants``,
+``declared_plant``, ``friction`` (levels in N and as coefficients of F_N), ``encoder``, ``timing``,
+``controller`` (with the gain K), ``segments`` (the open-loop plan), ``motion``,
+``replay_self_error_counts_rms``; DIR/manifest.json lists the cases and their generation times.
+
 CLI (from tests/):  python -m independent.campaign --out DIR --cases N --seed S [--workers W]
 API: draw_case(seed, index) -> spec; simulate(spec) -> data; contributions(spec, data);
 make_case(seed, index) -> (data, truth); write_case(out_dir, seed, index) -> truth;
