@@ -1,0 +1,488 @@
+"""Randomised identification campaign: cases drawn by ``tests/independent/campaign.py`` (code
+that shares nothing with ipfric_core), each identified by ``ipfric identify`` and scored.
+
+    python -m bench.ident_campaign --out runs/campaign --cases 40 --seed 1 [--threshold 2]
+    python -m bench.ident_campaign --out runs/campaign --rescore      # score existing results again
+
+A case's expected answer: the library effect(s) whose own contribution (truth
+``contribution_counts_rms``: multiple shooting on 1 s windows, cart encoder counts; angle counts
+for ``sensor_bias``) reaches the threshold; ``not_explained`` when only an effect from outside the
+library (spring, friction patch) or a wrong declared plant constant reaches it; ``none`` otherwise.
+Below the threshold any answer but a wrong library name is acceptable (recorded as such).
+The answer given: ``result['verdict']`` when the identification writes one (not explained ->
+``not_explained`` unless a library effect was added too), else ``result['effects_added']`` (the
+friction law's parts ``coulomb``, ``stribeck``, ``presliding`` are not effects).
+
+Writes out_dir/summary.json, summary.md and detection.png; out_dir/cases/<case>/ holds the data,
+the truth and the identification's report (``ident/result.json``, ``ident/stderr.txt``).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+from collections import Counter, defaultdict
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT / 'tests') not in sys.path:
+    sys.path.insert(0, str(ROOT / 'tests'))
+
+from independent import campaign  # noqa: E402
+
+FRICTION_PARTS = {'coulomb', 'stribeck', 'presliding'}
+OUTSIDE = set(campaign.OUTSIDE) | {'plant_error'}
+THRESHOLD = 2.0          # counts RMS: an effect's contribution from which it must be named
+BINS = (0.0, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 1000.0, math.inf)
+TIMEOUT = 1800.0
+
+
+def library_names() -> set[str]:
+    """The identification's effect library (the friction law's parts left out)."""
+    from ipfric_core.ident.effects import EFFECTS
+    return set(EFFECTS) - FRICTION_PARTS
+
+
+# ------------------------------------------------------------------------------------ answers
+def components(truth: dict) -> list[dict]:
+    """Every undeclared discrepancy of a case: effects and a wrong declared constant."""
+    out = [dict(name=k, library=bool(v['library']), counts=float(v['contribution_counts_rms']))
+           for k, v in truth['effects'].items()]
+    pe = truth.get('plant_error')
+    if pe:
+        out.append(dict(name='plant_error', library=False, counts=float(pe['contribution_counts_rms']),
+                        detail=f'{pe["name"]} declared x{pe["factor"]:.2f}'))
+    return out
+
+
+def expected_answer(truth: dict, threshold: float = THRESHOLD) -> dict:
+    comps = components(truth)
+    above = sorted(c['name'] for c in comps if c['library'] and c['counts'] >= threshold)
+    outside = sorted(c['name'] for c in comps if not c['library'] and c['counts'] >= threshold)
+    below = sorted(c['name'] for c in comps if c['counts'] < threshold)
+    label = '+'.join(above) if above else ('not_explained' if outside else 'none')
+    return dict(label=label, library=above, outside=outside, below=below,
+                clean=not comps)
+
+
+def predicted_answer(result: dict | None) -> dict:
+    if result is None:
+        return dict(label='error', added=[], verdict=None)
+    added = sorted(e for e in result.get('effects_added', []) if e not in FRICTION_PARTS)
+    verdict = result.get('verdict')
+    if added:
+        label = '+'.join(added)
+    elif isinstance(verdict, dict) and verdict.get('explained') is False:
+        label = 'not_explained'
+    else:
+        label = 'none'
+    return dict(label=label, added=added, verdict=verdict)
+
+
+def outcome(expected: dict, predicted: dict) -> str:
+    """correct | acceptable (below threshold) | partial | false_positive | missed | wrong | error."""
+    e, p = expected['label'], predicted['label']
+    if p == 'error':
+        return 'error'
+    if p == e:
+        return 'correct'
+    if e == 'none':
+        if expected['clean']:
+            return 'false_positive'
+        if p == 'not_explained' or set(predicted['added']) <= set(expected['below']):
+            return 'acceptable'
+        return 'wrong'
+    if e == 'not_explained':
+        return 'missed' if p == 'none' else 'wrong'
+    if p in ('none', 'not_explained'):
+        return 'missed'
+    if set(predicted['added']) & set(expected['library']):
+        return 'partial'
+    return 'wrong'
+
+
+# ------------------------------------------------------------------------------ identification
+def identify_command(case_dir: Path, truth: dict) -> list[str]:
+    cmd = ['identify', str(case_dir / 'data.csv'), '--plant', str(case_dir / 'plant.yaml'),
+           '--out', str(case_dir / 'ident'), '--no-plots', '--json']
+    if not truth['pendulum_attached']:
+        cmd.append('--cart-alone')
+    return cmd
+
+
+def identify_case(case_dir: Path, truth: dict, timeout: float = TIMEOUT) -> dict:
+    """Run ``ipfric identify`` on a case in a subprocess; its result.json (or None), wall time, exit
+    code and the last lines of its standard error."""
+    cmd = identify_command(case_dir, truth)
+    env = dict(os.environ, OPENBLAS_NUM_THREADS='1', MKL_NUM_THREADS='1')
+    (case_dir / 'ident').mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    try:
+        proc = subprocess.run([sys.executable, '-m', 'ipfric_core.cli', *cmd], cwd=ROOT, env=env,
+                              capture_output=True, text=True, timeout=timeout)
+        rc, err = proc.returncode, proc.stderr
+    except subprocess.TimeoutExpired as exc:
+        rc, err = 'timeout', (exc.stderr or b'').decode() if isinstance(exc.stderr, bytes) else (exc.stderr or '')
+    wall = time.perf_counter() - t0
+    (case_dir / 'ident' / 'stderr.txt').write_text(err or '')
+    path = case_dir / 'ident' / 'result.json'
+    result = None
+    if rc == 0 and path.exists():
+        result = json.loads(path.read_text())
+    tail = [ln for ln in (err or '').strip().splitlines() if ln.strip()][-3:]
+    return dict(result=result, wall_s=round(wall, 2), rc=rc, stderr_tail=tail,
+                command='./ipfric ' + ' '.join(cmd))
+
+
+# ----------------------------------------------------------------------------------- the oracle
+def oracle_model_values(truth: dict) -> tuple[dict, list[tuple[str, dict]]]:
+    """The truth in the identification's own parameters: friction levels [N] and each library
+    effect with its values (effects from outside the library have no such parameters)."""
+    fr = truth['friction']
+    values = {'Fc': fr['Fc'], 'Fs_excess': fr['Fs_excess'], 'eps': fr['eps'], 'v_s': fr['v_s']}
+    effects = []
+    for name, q in sorted(truth['effects'].items()):
+        if name == 'deadzone':
+            effects.append((name, {'dz': q['dz_V']}))
+        elif name == 'saturation':
+            effects.append((name, {'u_max': q['u_max_V']}))
+        elif name == 'delay':
+            effects.append((name, {'delay': q['delay_s']}))
+        elif name == 'cogging':
+            a = q['amplitude_N']
+            effects.append((name, {'cog_a': a * math.cos(q['phase_rad']), 'cog_b': a * math.sin(q['phase_rad']),
+                                   'cog_period': q['period_m']}))
+        elif name == 'asymmetry':
+            effects.append((name, {'asym': q['a'], 'asym_v': 0.0}))
+        elif name == 'offset':
+            effects.append((name, {'F0': q['F0_N']}))
+        elif name == 'sensor_bias':
+            effects.append((name, {'theta_bias': q['theta_bias_rad']}))
+        elif name == 'drive_backlash':
+            effects.append((name, {'drive_gap': q['gap_m'], 'drive_mass': q['motor_mass_kg'],
+                                   'drive_stiffness': q['k_N_per_m'], 'drive_damping': q['c_N_s_per_m']}))
+    return values, effects
+
+
+def oracle(case_dir: Path, truth: dict, split: float = 0.6) -> dict:
+    """The identification's validation simulation error of the TRUE model (true constants, friction
+    and library effects; an outside effect left out): what its ladder could reach at best on this
+    file with its own loader and metric. Far above the encoders' rounding on a case whose effects
+    are all in the library, it says the data hold something the identification's model does not
+    represent (a hanging pendulum read as upright, a zeros angle column taken for a pendulum)."""
+    try:
+        from ipfric_core.ident.ladder import Problem
+        from ipfric_core.ident.model import load_declared
+        from ipfric_core.ident.records import load
+        from ipfric_core.physics.params import PlantParams
+        plant = PlantParams(**truth['constants'])
+        rec = load(case_dir / 'data.csv', plant, None, not truth['pendulum_attached'])
+        _, val = rec.split(split)
+        values, effects = oracle_model_values(truth)
+        model = load_declared(None, 'exponential', rec.theta is not None, plant).with_values(values)
+        for name, q in effects:
+            model = model.with_effect(name, q)
+        out = Problem(val).summary(model)
+        return {k: float(v) for k, v in out.items() if isinstance(v, (int, float))}
+    except Exception as exc:      # noqa: BLE001  (a refused file: the identification's message)
+        return {'error': f'{type(exc).__name__}: {exc}'}
+
+
+# ------------------------------------------------------------------------------------- scoring
+def score_case(truth: dict, ident: dict, threshold: float = THRESHOLD, generation_s: float | None = None,
+               oracle_counts: dict | None = None) -> dict:
+    exp = expected_answer(truth, threshold)
+    pred = predicted_answer(ident.get('result'))
+    res = ident.get('result') or {}
+    ladder = [(s['step'], round(s['validation']['x_rms_counts'], 3)) for s in res.get('ladder', [])]
+    return dict(
+        case=truth['case'], index=truth['index'], experiment=truth['experiment'],
+        theta_column=truth['theta_column'], sample_period_s=truth['sample_period_s'],
+        duration_s=truth['duration_s'], timing=truth['timing']['kind'],
+        components=components(truth), expected=exp['label'], expected_detail=exp,
+        predicted=pred['label'], added=pred['added'], verdict=pred['verdict'],
+        outcome=outcome(exp, pred), validation_counts=ladder, oracle_counts=oracle_counts,
+        wall_s=ident.get('wall_s'),
+        generation_s=generation_s if generation_s is not None else truth.get('generation_s'),
+        rc=ident.get('rc'), stderr_tail=ident.get('stderr_tail'),
+        command=ident.get('command'))
+
+
+def detection_limit(points: list[tuple[float, bool]], share: float = 0.95, least: int = 3):
+    """Smallest contribution c such that of the cases at or above c at least ``share`` are named
+    right (and at least ``least`` such cases); None when no such c."""
+    pts = sorted(points)
+    for i, (c, _) in enumerate(pts):
+        tail = [ok for _, ok in pts[i:]]
+        if len(tail) >= least and sum(tail) / len(tail) >= share:
+            return c
+    return None
+
+
+def summarize(cases: list[dict], threshold: float, meta: dict) -> dict:
+    confusion = defaultdict(Counter)
+    for c in cases:
+        confusion[c['expected']][c['predicted']] += 1
+    per_effect = defaultdict(list)        # name -> [(counts, named right, answer)]
+    for c in cases:
+        for comp in c['components']:
+            if comp['library']:
+                ok = comp['name'] in c['added']
+            else:
+                ok = c['predicted'] == 'not_explained'
+            per_effect[comp['name']].append((comp['counts'], ok, c['predicted'], c['case']))
+    rates = {}
+    for name, pts in sorted(per_effect.items()):
+        bins = []
+        for lo, hi in zip(BINS[:-1], BINS[1:]):
+            sel = [ok for cnt, ok, *_ in pts if lo <= cnt < hi]
+            if sel:
+                bins.append(dict(lo=lo, hi=hi, n=len(sel), named=int(sum(sel)), rate=sum(sel) / len(sel)))
+        above = [ok for cnt, ok, *_ in pts if cnt >= threshold]
+        instead = Counter(ans for cnt, ok, ans, _ in pts if cnt >= threshold and not ok)
+        rates[name] = dict(
+            n=len(pts), n_above=len(above), named_above=int(sum(above)),
+            rate_above=(sum(above) / len(above)) if above else None, bins=bins,
+            detection_limit_counts=detection_limit([(cnt, ok) for cnt, ok, *_ in pts]),
+            answered_instead=dict(instead),
+            points=[dict(case=case, counts=cnt, named=ok, answer=ans) for cnt, ok, ans, case in pts])
+    clean = [c for c in cases if not c['components']]
+    walls = [c['wall_s'] for c in cases if c['wall_s'] is not None]
+    gens = [c['generation_s'] for c in cases if c['generation_s'] is not None]
+    outcomes = Counter(c['outcome'] for c in cases)
+    by_setting = {}
+    for key in sorted({(c['experiment'], c['theta_column']) for c in cases}):
+        sel = [c for c in cases if (c['experiment'], c['theta_column']) == key]
+        floors = [c['oracle_counts']['x_rms_counts'] for c in sel
+                  if c.get('oracle_counts') and 'x_rms_counts' in c['oracle_counts']]
+        by_setting[f'{key[0]} / {key[1]}'] = dict(
+            n=len(sel), right=sum(c['outcome'] in ('correct', 'acceptable') for c in sel),
+            outcomes=dict(Counter(c['outcome'] for c in sel)),
+            true_model_counts_median=float(np.median(floors)) if floors else None)
+    return dict(
+        meta=meta, threshold_counts=threshold, n_cases=len(cases), outcomes=dict(outcomes),
+        right_share=(outcomes['correct'] + outcomes['acceptable']) / max(1, len(cases)),
+        confusion={k: dict(v) for k, v in sorted(confusion.items())},
+        clean=dict(n=len(clean), anything_added=sum(1 for c in clean if c['added']),
+                   not_explained=sum(1 for c in clean if c['predicted'] == 'not_explained'),
+                   share_anything_added=(sum(1 for c in clean if c['added']) / len(clean)) if clean else None,
+                   added=dict(Counter(c['predicted'] for c in clean if c['added']))),
+        per_effect=rates, by_setting=by_setting,
+        timing=dict(identify_wall_s_mean=float(np.mean(walls)) if walls else None,
+                    identify_wall_s_median=float(np.median(walls)) if walls else None,
+                    identify_wall_s_max=float(np.max(walls)) if walls else None,
+                    identify_wall_s_total=float(np.sum(walls)) if walls else None,
+                    generation_s_mean=float(np.mean(gens)) if gens else None,
+                    generation_s_total=float(np.sum(gens)) if gens else None),
+        errors=[dict(case=c['case'], rc=c['rc'], command=c['command'], stderr_tail=c['stderr_tail'])
+                for c in cases if c['outcome'] == 'error'],
+        cases=cases)
+
+
+def _fmt(v, nd=3):
+    return '-' if v is None else (f'{v:.{nd}g}' if isinstance(v, float) else str(v))
+
+
+def write_markdown(s: dict, path: Path) -> None:
+    L = [f'# Identification campaign: {s["n_cases"]} cases, seed {s["meta"].get("seed")}', '',
+         f'Threshold {s["threshold_counts"]:g} counts RMS (an effect at or above it must be named). '
+         f'Right (correct or acceptable): {100 * s["right_share"]:.0f} %. Outcomes: '
+         + ', '.join(f'{k} {v}' for k, v in sorted(s['outcomes'].items())) + '.', '']
+    cols = sorted({p for row in s['confusion'].values() for p in row})
+    L += ['## Confusion matrix (rows: truth, columns: answer)', '',
+          '| truth \\ answer | ' + ' | '.join(cols) + ' | n |', '|---' * (len(cols) + 2) + '|']
+    for row, cnt in s['confusion'].items():
+        L.append(f'| **{row}** | ' + ' | '.join(str(cnt.get(c, '')) for c in cols) + f' | {sum(cnt.values())} |')
+    cl = s['clean']
+    L += ['', f'Clean cases: {cl["n"]}, with anything added: {cl["anything_added"]} '
+          f'({_fmt(None if cl["share_anything_added"] is None else 100 * cl["share_anything_added"])} %) '
+          f'{cl["added"] or ""}; declared not explained: {cl["not_explained"]}.', '',
+          '## Per effect', '',
+          '| effect | cases | at/above threshold | named (above) | detection limit [counts] '
+          '| answered instead (above) |',
+          '|---|---|---|---|---|---|']
+    for name, r in s['per_effect'].items():
+        L.append(f'| {name} | {r["n"]} | {r["n_above"]} | {r["named_above"]} | '
+                 f'{_fmt(r["detection_limit_counts"]) if r["detection_limit_counts"] is not None else "not reached"} | '
+                 + ', '.join(f'{k} {v}' for k, v in r['answered_instead'].items()) + ' |')
+    L += ['', 'Detection rate against contribution (counts RMS; named / cases per bin):', '']
+    for name, r in s['per_effect'].items():
+        L.append(f'- {name}: ' + '; '.join(f'[{b["lo"]:g}, {b["hi"]:g}) {b["named"]}/{b["n"]}' for b in r['bins']))
+    L += ['', '## By experiment and angle column', '',
+          "True model: median over the cases of the identification's validation error of the true model "
+          '(the floor its ladder could reach).', '',
+          '| experiment / theta column | cases | right | outcomes | true model [counts], median |',
+          '|---|---|---|---|---|']
+    for k, v in s['by_setting'].items():
+        L.append(f'| {k} | {v["n"]} | {v["right"]} | ' + ', '.join(f'{a} {b}' for a, b in sorted(v['outcomes'].items()))
+                 + f' | {_fmt(v["true_model_counts_median"])} |')
+    t = s['timing']
+    L += ['', '## Time', '',
+          f'Identification wall time per case: mean {_fmt(t["identify_wall_s_mean"])} s, median '
+          f'{_fmt(t["identify_wall_s_median"])} s, max {_fmt(t["identify_wall_s_max"])} s, total '
+          f'{_fmt(t["identify_wall_s_total"])} s. Generation per case: mean {_fmt(t["generation_s_mean"])} s.', '']
+    if s['errors']:
+        L += ['## Identification errors', '']
+        for e in s['errors']:
+            L.append(f'- {e["case"]} (exit {e["rc"]}): `{e["command"]}`: ' + ' / '.join(e['stderr_tail']))
+        L.append('')
+    L += ['## Cases', '',
+          "Validation simulation error in the identification's metric (cart counts RMS); true model: the "
+          'same metric for the true constants, friction and library effects (an outside effect left out), '
+          'the best the ladder could reach.', '',
+          '| case | experiment | theta | Ts [ms] | truth (counts) | expected | answer | outcome | '
+          'validation counts (declared -> refit -> final) | true model | wall [s] |', '|---' * 11 + '|']
+    for c in s['cases']:
+        comp = ', '.join(f'{x["name"]} {x["counts"]:.3g}' for x in c['components']) or 'clean'
+        val = ' -> '.join(f'{v:.3g}' for _, v in c['validation_counts'])
+        orc = c.get('oracle_counts') or {}
+        orc_s = 'refused' if 'error' in orc else _fmt(orc.get('x_rms_counts'))
+        L.append(f'| {c["case"]} | {c["experiment"]} | {c["theta_column"]} | {1e3 * c["sample_period_s"]:.3g} | '
+                 f'{comp} | {c["expected"]} | {c["predicted"]} | {c["outcome"]} | {val} | {orc_s} | '
+                 f'{_fmt(c["wall_s"])} |')
+    path.write_text('\n'.join(L) + '\n')
+
+
+def plot(s: dict, path: Path) -> None:
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    names = list(s['per_effect'])
+    if not names:
+        return
+    ncol = 3
+    nrow = math.ceil(len(names) / ncol)
+    fig, axes = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 3.0 * nrow), squeeze=False)
+    rng = np.random.default_rng(0)
+    for ax, name in zip(axes.flat, names):
+        r = s['per_effect'][name]
+        x = np.array([max(p['counts'], 1e-2) for p in r['points']])
+        y = np.array([1.0 if p['named'] else 0.0 for p in r['points']])
+        ax.scatter(x, y + rng.uniform(-0.04, 0.04, y.size), s=14, alpha=0.6, color='tab:blue', label='case')
+        bx = [math.sqrt(max(b['lo'], 1e-2) * (b['hi'] if math.isfinite(b['hi']) else 3 * b['lo'])) for b in r['bins']]
+        ax.plot(bx, [b['rate'] for b in r['bins']], 'o-', color='tab:red', label='rate per bin')
+        ax.axvline(s['threshold_counts'], color='grey', ls='--', lw=1)
+        if r['detection_limit_counts'] is not None:
+            ax.axvline(r['detection_limit_counts'], color='tab:green', ls=':', lw=1.5, label='95 % limit')
+        ax.set_xscale('log')
+        ax.set_ylim(-0.1, 1.1)
+        ax.set_title(f'{name} ({r["n"]} cases)', fontsize=10)
+        ax.set_xlabel('contribution [counts RMS]')
+        ax.set_ylabel('named right' if name not in OUTSIDE else '"not explained"')
+    for ax in list(axes.flat)[len(names):]:
+        ax.axis('off')
+    axes.flat[0].legend(fontsize=7, loc='center right')
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def write_summary(out_dir: Path, cases: list[dict], threshold: float, meta: dict) -> dict:
+    s = summarize(cases, threshold, meta)
+    (out_dir / 'summary.json').write_text(json.dumps(s, indent=1, default=str))
+    write_markdown(s, out_dir / 'summary.md')
+    plot(s, out_dir / 'detection.png')
+    return s
+
+
+# ------------------------------------------------------------------------------------- driver
+def run_campaign(out_dir, n_cases, seed, workers=1, progress=None, threshold=THRESHOLD, indices=None,
+                 timeout=TIMEOUT, generate_workers=None, with_oracle=True) -> dict:
+    """Generate cases (seed, i), identify each (``workers`` identifications at a time), score;
+    returns the summary (also written to out_dir/summary.json, summary.md, detection.png).
+    ``with_oracle``: also the identification's error of the true model on each case (:func:`oracle`)."""
+    out_dir = Path(out_dir)
+    case_root = out_dir / 'cases'
+    indices = list(range(n_cases)) if indices is None else list(indices)
+    say = progress or (lambda msg: None)
+    t0 = time.perf_counter()
+    manifest = campaign.generate(case_root, len(indices), seed, indices, generate_workers or workers,
+                                 lambda case, s: say(f'generated {case} in {s:.1f} s'))
+    gen_wall = time.perf_counter() - t0
+    names = list(manifest['cases'])
+
+    def one(name):
+        d = case_root / name
+        truth = json.loads((d / 'truth.json').read_text())
+        ident = identify_case(d, truth, timeout)
+        orc = oracle(d, truth) if with_oracle else None
+        (d / 'ident' / 'meta.json').write_text(json.dumps(
+            dict({k: v for k, v in ident.items() if k != 'result'}, oracle_counts=orc)))
+        return score_case(truth, ident, threshold, manifest['generation_s'].get(name), orc)
+
+    cases = []
+    if workers > 1:
+        from concurrent.futures import ThreadPoolExecutor
+        with ThreadPoolExecutor(workers) as ex:
+            for c in ex.map(one, names):
+                cases.append(c)
+                say(f'{c["case"]}: expected {c["expected"]}, answer {c["predicted"]} ({c["outcome"]}), {c["wall_s"]} s')
+    else:
+        for name in names:
+            c = one(name)
+            cases.append(c)
+            say(f'{c["case"]}: expected {c["expected"]}, answer {c["predicted"]} ({c["outcome"]}), {c["wall_s"]} s')
+    meta = dict(seed=seed, indices=indices, workers=workers, generation_wall_s=round(gen_wall, 1),
+                total_wall_s=round(time.perf_counter() - t0, 1),
+                date_utc=time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime()),
+                load_average_at_end=os.getloadavg())
+    return write_summary(out_dir, cases, threshold, meta)
+
+
+def rescore(out_dir, threshold=THRESHOLD, with_oracle=False) -> dict:
+    """Score the identifications already in out_dir again (another threshold, a changed scorer);
+    ``with_oracle``: compute the true model's error where it is missing."""
+    out_dir = Path(out_dir)
+    cases = []
+    gen = {}
+    if (out_dir / 'cases' / 'manifest.json').exists():
+        gen = json.loads((out_dir / 'cases' / 'manifest.json').read_text()).get('generation_s', {})
+    for d in sorted((out_dir / 'cases').glob('case*')):
+        truth = json.loads((d / 'truth.json').read_text())
+        meta_p, res_p = d / 'ident' / 'meta.json', d / 'ident' / 'result.json'
+        if not meta_p.exists():
+            continue
+        ident = json.loads(meta_p.read_text())
+        ident['result'] = json.loads(res_p.read_text()) if ident.get('rc') == 0 and res_p.exists() else None
+        orc = ident.get('oracle_counts')
+        if orc is None and with_oracle:
+            orc = oracle(d, truth)
+            meta_p.write_text(json.dumps(dict({k: v for k, v in ident.items() if k != 'result'}, oracle_counts=orc)))
+        cases.append(score_case(truth, ident, threshold, gen.get(d.name), orc))
+    old = {}
+    if (out_dir / 'summary.json').exists():
+        old = json.loads((out_dir / 'summary.json').read_text()).get('meta', {})
+    return write_summary(out_dir, cases, threshold, dict(old, rescored=True))
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    ap.add_argument('--out', required=True)
+    ap.add_argument('--cases', type=int, default=40)
+    ap.add_argument('--seed', type=int, default=1)
+    ap.add_argument('--indices', help='comma-separated case indices instead of 0..N-1')
+    ap.add_argument('--threshold', type=float, default=THRESHOLD, help='counts RMS (default %(default)s)')
+    ap.add_argument('--workers', type=int, default=1, help='identifications at a time (default 1)')
+    ap.add_argument('--timeout', type=float, default=TIMEOUT, help='seconds per identification')
+    ap.add_argument('--rescore', action='store_true', help='score the results already in --out')
+    ap.add_argument('--no-oracle', action='store_true', help="skip the true model's error per case")
+    a = ap.parse_args(argv)
+    if a.rescore:
+        s = rescore(a.out, a.threshold, not a.no_oracle)
+    else:
+        idx = [int(i) for i in a.indices.split(',')] if a.indices else None
+        s = run_campaign(a.out, a.cases, a.seed, a.workers, lambda m: print(m, flush=True), a.threshold, idx,
+                         a.timeout, with_oracle=not a.no_oracle)
+    print(Path(a.out) / 'summary.md')
+    print(json.dumps({k: s[k] for k in ('outcomes', 'confusion', 'clean', 'timing')}, indent=1))
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
