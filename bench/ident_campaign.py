@@ -149,24 +149,25 @@ def oracle_model_values(truth: dict) -> tuple[dict, list[tuple[str, dict]]]:
     effects = []
     for name, q in sorted(truth['effects'].items()):
         if name == 'deadzone':
-            effects.append((name, {'dz': q['dz_V']}))
+            effects.append((name, {'deadzone_V': q['dz_V']}))
         elif name == 'saturation':
-            effects.append((name, {'u_max': q['u_max_V']}))
+            effects.append((name, {'saturation_V': q['u_max_V']}))
         elif name == 'delay':
-            effects.append((name, {'delay': q['delay_s']}))
+            effects.append((name, {'input_delay_s': q['delay_s']}))
         elif name == 'cogging':
             a = q['amplitude_N']
-            effects.append((name, {'cog_a': a * math.cos(q['phase_rad']), 'cog_b': a * math.sin(q['phase_rad']),
-                                   'cog_period': q['period_m']}))
+            effects.append((name, {'cogging_sin_N': a * math.cos(q['phase_rad']),
+                                   'cogging_cos_N': a * math.sin(q['phase_rad']), 'cogging_period_m': q['period_m']}))
         elif name == 'asymmetry':
-            effects.append((name, {'asym': q['a'], 'asym_v': 0.0}))
+            effects.append((name, {'asymmetry': q['a'], 'asymmetry_viscous_Ns_per_m': 0.0}))
         elif name == 'offset':
-            effects.append((name, {'F0': q['F0_N']}))
+            effects.append((name, {'offset_N': q['F0_N']}))
         elif name == 'sensor_bias':
-            effects.append((name, {'theta_bias': q['theta_bias_rad']}))
+            effects.append((name, {'bias_theta_rad': q['theta_bias_rad']}))
         elif name == 'drive_backlash':
-            effects.append((name, {'drive_gap': q['gap_m'], 'drive_mass': q['motor_mass_kg'],
-                                   'drive_stiffness': q['k_N_per_m'], 'drive_damping': q['c_N_s_per_m']}))
+            effects.append((name, {'drive_backlash_m': q['gap_m'], 'drive_mass_kg': q['motor_mass_kg'],
+                                   'drive_stiffness_N_per_m': q['k_N_per_m'],
+                                   'drive_damping_Ns_per_m': q['c_N_s_per_m']}))
     return values, effects
 
 
@@ -177,9 +178,9 @@ def oracle(case_dir: Path, truth: dict, split: float = 0.6) -> dict:
     are all in the library, it says the data hold something the identification's model does not
     represent (a hanging pendulum read as upright, a zeros angle column taken for a pendulum)."""
     try:
+        from ipfric_core.analysis.records import load
         from ipfric_core.ident.ladder import Problem
         from ipfric_core.ident.model import load_declared
-        from ipfric_core.ident.records import load
         from ipfric_core.physics.params import PlantParams
         plant = PlantParams(**truth['constants'])
         rec = load(case_dir / 'data.csv', plant, None, not truth['pendulum_attached'])
