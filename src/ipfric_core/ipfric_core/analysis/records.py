@@ -17,21 +17,29 @@ from __future__ import annotations
 import csv
 import gzip
 import io
+import math
 from array import array
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import IO
 
 import numpy as np
+from scipy.signal import butter, sosfiltfilt
 
 from ..physics.params import ConfigError, PlantParams
 
-__all__ = ['Record', 'smallest_step', 'ANGLE_ZEROS', 'is_log', 'parse_columns', 'load', 'trajectory_record']
+__all__ = ['Record', 'smallest_step', 'smooth_rate', 'angle_equation', 'upright_angle', 'frozen_tail', 'ANGLE_ZEROS',
+           'is_log', 'parse_columns', 'load', 'trajectory_record']
 
 MIN_SAMPLES = 200
+MIN_PART_COUNTS = 100   # encoder counts an estimation or validation part must move at least
 MAX_ROWS = 2_000_000    # a longer CSV is refused (33 min at 1 kHz; identification would take hours)
 MAX_VOLTAGE = 1e3       # |u| beyond this is not a drive command [V]
 OVERRUN_JUMP = 1.75     # a stamp step this many times the median period starts an overrun
+GAP_PERIODS = 20        # a stamp step this many median periods (and at least GAP_S) is a gap in the log
+GAP_S = 0.05            # [s]
+FROZEN_S = 0.5          # a tail this long where no column changes is a stopped log [s]
+RATE_HZ = 25.0          # corner of the filtered derivatives of a record [Hz]
 MAX_FROZEN = 5          # samples after a jump that may repeat the last reading
 
 
@@ -82,15 +90,35 @@ class Record:
         """The angle encoder's count [rad]: the smallest step of theta."""
         return smallest_step(self.theta) if self.theta is not None else 1.0
 
+    def part(self, a: int, b: int, tag: str) -> Record:
+        """Samples a .. b - 1 as a record of their own, ``tag`` added to its name."""
+        return replace(self, name=f'{self.name} ({tag})', t=self.t[a:b], x=self.x[a:b], u=self.u[a:b],
+                       theta=None if self.theta is None else self.theta[a:b],
+                       valid=None if self.valid is None else self.valid[a:b])
+
+    def motion(self) -> np.ndarray:
+        """Encoder counts moved up to each sample (cart and angle together): where the record moves."""
+        steps = np.abs(np.diff(self.x)) / self.x_resolution
+        if self.theta is not None:
+            steps = steps + np.abs(np.diff(self.theta)) / self.theta_resolution
+        return np.concatenate([[0.0], np.cumsum(np.where(self.valid_mask[1:], steps, 0.0))])
+
     def split(self, fraction: float) -> tuple[Record, Record]:
-        """(first ``fraction``, rest) in time: estimation and validation parts."""
-        k = int(round(fraction * len(self.t)))
-        parts = []
-        for sl, tag in ((slice(0, k), 'estimation'), (slice(k, None), 'validation')):
-            parts.append(replace(self, name=f'{self.name} ({tag})', t=self.t[sl], x=self.x[sl], u=self.u[sl],
-                                 theta=None if self.theta is None else self.theta[sl],
-                                 valid=None if self.valid is None else self.valid[sl]))
-        return parts[0], parts[1]
+        """(estimation, validation): the first part holds ``fraction`` of the record's motion
+        (:meth:`motion`), the rest the remainder, so both parts move whatever the record does
+        (a log that moves early and then rests is not split in time). ConfigError when the record
+        hardly moves or a part would hold fewer than MIN_PART_COUNTS of motion."""
+        moved = self.motion()
+        total = float(moved[-1])
+        k = int(np.searchsorted(moved, fraction * total))
+        k = min(max(k, MIN_SAMPLES // 2), len(self.t) - MIN_SAMPLES // 2)
+        part_motion = (float(moved[k]), total - float(moved[k]))
+        if min(part_motion) < MIN_PART_COUNTS:
+            raise ConfigError(f'{self.name}: cannot split into estimation and validation parts that both move: '
+                              f'{total:.0f} encoder counts of motion in all, {part_motion[0]:.0f} before and '
+                              f'{part_motion[1]:.0f} after t = {self.t[k]:.3g} s (each part needs '
+                              f'{MIN_PART_COUNTS:g}); record more motion, or give --validation FILE')
+        return self.part(0, k, 'estimation'), self.part(k, len(self.t), 'validation')
 
 
 def smallest_step(y, still: float = 1.0) -> float:
@@ -100,6 +128,18 @@ def smallest_step(y, still: float = 1.0) -> float:
     steps = np.abs(np.diff(y))
     steps = steps[steps > 1e-12 * max(1.0, float(np.max(np.abs(y))))] if len(y) else steps
     return float(steps.min()) if len(steps) else still
+
+
+def smooth_rate(t: np.ndarray, y: np.ndarray, valid: np.ndarray | None = None,
+                cutoff_hz: float = RATE_HZ) -> np.ndarray:
+    """dy/dt of a sampled signal [unit/s]: zero-phase 4th-order Butterworth at ``cutoff_hz`` on a uniform
+    grid (the record's median period; ``valid`` samples only), differentiated, read back at ``t``."""
+    valid = np.ones(len(t), bool) if valid is None else valid
+    dt = float(np.median(np.diff(t)))
+    grid = np.arange(t[0], t[-1] + 0.5 * dt, dt)
+    yg = np.interp(grid, t[valid], y[valid])
+    f = sosfiltfilt(butter(4, min(cutoff_hz, 0.4 / dt), fs=1.0 / dt, output='sos'), yg)
+    return np.interp(t, grid, np.gradient(f, dt))
 
 
 def overruns(t: np.ndarray, readings: list) -> np.ndarray:
@@ -117,6 +157,8 @@ def overruns(t: np.ndarray, readings: list) -> np.ndarray:
 
 
 ANGLE_ZEROS = ('auto', 'upright', 'hanging')
+#: the t statistic a term of the pendulum's equation needs to decide an angle column's zero or sign
+CONVENTION_T = 6.0
 #: the record names a CSV's columns map to (``--columns NAME=HEADER``)
 COLUMNS = ('t', 'x', 'voltage', 'theta')
 #: suffixes of rig logs (a CSV table, a MATLAB file); anything else is a run bag
@@ -140,23 +182,79 @@ def parse_columns(text: str | None) -> dict[str, str]:
     return columns
 
 
-def upright_angle(theta: np.ndarray, zero: str = 'auto') -> tuple[np.ndarray, list[str]]:
-    """theta from upright [rad]: unwrapped, and shifted by pi when measured from hanging
-    (``zero`` 'hanging', or 'auto' when its median lies more than pi/2 from upright)."""
+def angle_equation(t, x, theta) -> tuple[np.ndarray, np.ndarray]:
+    """The pendulum's own equation (paper eq. 1), theta'' = a sin(theta) + b x'' cos(theta), fitted to
+    the filtered record by least squares (every 10 ms, the first and last 0.1 s left out): (a, b) and
+    their t statistics. For theta from upright with the paper's sign, a = 3 g / (4 l) > 0 and
+    b = -3 / (4 l) < 0; measured from hanging, both change sign; positive the other way round, b does."""
+    acc = smooth_rate(t, smooth_rate(t, x))
+    wdd = smooth_rate(t, smooth_rate(t, theta))
+    inside = np.flatnonzero((t > t[0] + 0.1) & (t < t[-1] - 0.1))
+    idx = inside[::max(1, int(round(0.01 / float(np.median(np.diff(t))))))]
+    A = np.column_stack([np.sin(theta[idx]), acc[idx] * np.cos(theta[idx])])
+    y = wdd[idx]
+    if len(idx) < 10 or np.linalg.matrix_rank(A) < 2:
+        return np.zeros(2), np.zeros(2)
+    coef = np.linalg.lstsq(A, y, rcond=None)[0]
+    r = y - A @ coef
+    cov = float(r @ r) / max(1, len(y) - 2) * np.linalg.pinv(A.T @ A)
+    return coef, coef / np.sqrt(np.maximum(np.diag(cov), 1e-300))
+
+
+def upright_angle(t, x, theta, l: float, g: float, zero: str = 'auto') -> tuple[np.ndarray, list[str]]:
+    """The angle column as the model takes it: radians from upright, the paper's sign, unwrapped
+    (a hanging pendulum about pi). ``zero`` says where the column is zero: 'upright', 'hanging' (then
+    pi is added), or 'auto': the pendulum's own equation decides (:func:`angle_equation`: the sign of
+    its gravity term tells upright from hanging, that of its coupling to the cart the angle's sign,
+    each when its t statistic reaches CONVENTION_T and its size is the declared pendulum's); without
+    that evidence, from hanging when the angle stays more than 90 deg from its zero (a balancing
+    rig's log spends its time upright), else from upright, and the paper's sign."""
     if zero not in ANGLE_ZEROS:
         raise ConfigError(f'angle zero {zero!r} is not one of {", ".join(ANGLE_ZEROS)}')
     notes = []
     th = np.unwrap(theta)
     if np.any(np.abs(np.diff(theta)) > np.pi):
         notes.append('angle wrapped at +/-pi: unwrapped')
+    (grav, coupling), (t_grav, t_coupling) = angle_equation(t, x, th)
+    # the raw column's coefficients are (c a, s c b) for the reading s * column + (pi if c < 0): a > 0, b < 0;
+    # a term decides when it is significant and of the size the declared pendulum gives it (0.6-1.6x)
+    shows_gravity = abs(t_grav) >= CONVENTION_T and 0.6 < abs(grav) / (0.75 * g / l) < 1.6
+    shows_coupling = abs(t_coupling) >= CONVENTION_T and 0.6 < abs(coupling) / (0.75 / l) < 1.6
     turns = np.round(np.median(th) / (2 * np.pi))
-    if zero == 'hanging' or (zero == 'auto' and np.median(np.abs(th - 2 * np.pi * turns)) > np.pi / 2):
-        th = th - np.pi
-        notes.append('angle measured from hanging (pi at upright): mapped to upright = 0')
-    turns = np.round(np.median(th) / (2 * np.pi))
+    far = np.median(np.abs(th - 2 * np.pi * turns)) > np.pi / 2
+    if zero == 'auto' and shows_gravity:
+        offset = np.pi if grav < 0 else 0.0
+        notes.append('angle read as measured ' + ('from hanging' if offset else 'from upright') + ' (its equation\'s '
+                     f'gravity term, t = {abs(t_grav):.3g})')
+    elif zero == 'auto':
+        # no evidence from the motion: a log spends its time where its rig balances it, upright
+        offset = np.pi if far else 0.0
+        notes.append('the pendulum\'s motion does not show where its angle is zero (the gravity term of its '
+                     f'equation is {grav:.3g} 1/s^2 with t = {t_grav:.2g}, {0.75 * g / l:.3g} expected): read as '
+                     + ('measured from hanging, as the angle stays more than 90 deg from its zero' if far else
+                        'measured from upright') + '; --angle-zero says otherwise')
+    else:
+        offset = np.pi if zero == 'hanging' else 0.0
+    flip = -1.0 if offset else 1.0
+    sign = -flip * float(np.sign(coupling)) if shows_coupling else 1.0
+    if sign < 0:
+        notes.append(f'the angle is positive the other way round from the paper\'s (its coupling to the cart, '
+                     f't = {abs(t_coupling):.3g}): its sign is changed')
+    if abs(t_coupling) >= CONVENTION_T:
+        l_data = 0.75 / abs(coupling)
+        if not 0.7 < l_data / l < 1.4 and shows_coupling:
+            notes.append(f'the pendulum\'s coupling to the cart says l = {l_data:.3g} m, the declared l is {l:.3g} m')
+    out = sign * th + offset
+    turns = np.round(np.median(out) / (2 * np.pi))
     if turns:
-        th = th - 2 * np.pi * turns
-    return th, notes
+        out = out - 2 * np.pi * turns
+    hang = np.abs(np.angle(np.exp(1j * out))) > np.pi / 2
+    if hang.mean() > 0.5:
+        notes.append(f'the pendulum hangs ({100 * hang.mean():.0f} % of the samples more than 90 deg from upright)')
+    elif hang.any():
+        notes.append(f'the pendulum passes between hanging and upright ({100 * hang.mean():.0f} % of the samples '
+                     f'hanging)')
+    return out, notes
 
 
 def check_record(rec: Record, angle_zero: str = 'auto') -> Record:
@@ -203,9 +301,14 @@ def check_record(rec: Record, angle_zero: str = 'auto') -> Record:
         if np.max(np.abs(theta)) > 2 * np.pi and off_axis > 0.5:
             raise ConfigError(f'{rec.name}: column theta reaches {np.max(np.abs(theta)):g}; expected radians '
                               f'from upright or from hanging (degrees?)')
-        theta, found = upright_angle(theta, angle_zero)
+        theta, found = upright_angle(rec.t, rec.x, theta, rec.pendulum[1], rec.pendulum[2], angle_zero)
         notes += found
     valid = overruns(rec.t, [rec.x] + ([theta] if theta is not None else []))
+    gaps = np.flatnonzero(d > max(GAP_PERIODS * period, GAP_S)) + 1
+    if len(gaps):
+        valid[gaps] = False
+        notes.append(f'{len(gaps)} gap(s) in the log (longest {float(np.max(d[gaps - 1])):.3g} s, first at '
+                     f't = {rec.t[gaps[0] - 1]:.3g} s): no window spans one')
     if not valid.all():
         notes.append(f'{int((~valid).sum())} stale readings after {int(np.sum(np.diff(valid.astype(int)) == -1))} '
                      f'sample overruns (stamp jump, encoders frozen): not compared')
@@ -216,12 +319,32 @@ def check_record(rec: Record, angle_zero: str = 'auto') -> Record:
 
 
 def _rig_record(name, t, x, u, theta, plant: PlantParams, angle_zero: str = 'auto', notes=()) -> Record:
+    t, x, u = (np.asarray(a, float) for a in (t, x, u))
+    theta = None if theta is None else np.asarray(theta, float)
+    end, stopped = frozen_tail(t, [x, u] + ([theta] if theta is not None else []))
+    if stopped:
+        notes = tuple(notes) + (stopped,)
+        t, x, u, theta = t[:end], x[:end], u[:end], None if theta is None else theta[:end]
     pend = None if theta is None else (plant.m, plant.l, plant.g)
     fn = plant.normal_force if theta is not None else plant.M * plant.g
-    rec = check_record(Record(name, np.asarray(t, float), np.asarray(x, float), np.asarray(u, float),
-                              plant.alpha, plant.beta, None if theta is None else np.asarray(theta, float),
-                              pend, fn, stick_velocity=2e-3, cutoff_hz=25.0, plant=plant), angle_zero)
+    rec = check_record(Record(name, t, x, u, plant.alpha, plant.beta, theta, pend, fn, stick_velocity=2e-3,
+                              cutoff_hz=25.0, plant=plant), angle_zero)
     return replace(rec, notes=tuple(notes) + rec.notes)
+
+
+def frozen_tail(t: np.ndarray, columns: list) -> tuple[int, str]:
+    """(samples to keep, note): a log whose columns all stop changing FROZEN_S or more before its end (a
+    rig stopped at the track's end, a logger left running) is cut after the last change; (len, '') else."""
+    n = len(t)
+    changed = np.zeros(max(n - 1, 0), bool)
+    for c in columns:
+        changed |= np.diff(c) != 0.0
+    moves = np.flatnonzero(changed)
+    last = int(moves[-1]) + 2 if len(moves) else n
+    if last < n and t[-1] - t[last - 1] >= FROZEN_S and last >= MIN_SAMPLES:
+        return last, (f'nothing changes after t = {t[last - 1]:.3g} s (the last {t[-1] - t[last - 1]:.3g} s, '
+                      f'{n - last} samples): the stopped tail is left out')
+    return n, ''
 
 
 def pendulum_angle(theta, cart_alone: bool) -> tuple[np.ndarray | None, list[str]]:

@@ -41,7 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis.records import Record
+from ..analysis.records import Record, smooth_rate
 from ..physics.params import ConfigError
 from . import lsq, shooting
 from .effects import EFFECTS, PARAMS
@@ -309,7 +309,7 @@ def response_lag(rec: Record, max_lag: float = 0.1) -> float:
     """Lag [s] at which changes of the cart's acceleration follow changes of the command best (a
     step of the force is a step of the acceleration): a transport delay longer than it (plus
     two samples) is not in the data."""
-    v = shooting.rates(rec.t, rec.x, rec.valid_mask)
+    v = smooth_rate(rec.t, rec.x, rec.valid_mask, shooting.FILTER_HZ)
     du, da = np.diff(rec.u), np.diff(np.gradient(v, rec.t))
     n = int(max_lag / rec.dt)
     cc = [float(np.dot(du[:len(du) - k], da[k:])) for k in range(n)]

@@ -12,6 +12,7 @@ matplotlib.use('Agg')
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from ..analysis.records import smooth_rate  # noqa: E402
 from ..physics.friction import friction_force  # noqa: E402
 from . import shooting  # noqa: E402
 from .effects import PARAMS  # noqa: E402
@@ -101,7 +102,7 @@ MOVING = 0.005       # a speed above this moves the cart [m/s] (the speeds repor
 
 def speeds(rec) -> dict:
     """5th, 50th and 95th percentile of the cart's speed [m/s] over the samples where it moves."""
-    v = np.abs(shooting.rates(rec.t, rec.x, rec.valid_mask))
+    v = np.abs(smooth_rate(rec.t, rec.x, rec.valid_mask, shooting.FILTER_HZ))
     v = v[v > MOVING]
     if len(v) == 0:
         return {}

@@ -23,15 +23,14 @@ from dataclasses import dataclass, replace
 
 import numba
 import numpy as np
-from scipy.signal import butter, sosfiltfilt
 
-from ..analysis.records import Record
+from ..analysis.records import Record, smooth_rate
 from ..physics.compiled import compiled
 from ..physics.plant import motor_force, motor_side_free
 from ..physics.rig import delayed_means, delayed_pieces, input_effects, inputs_through, play
 from ..physics.simulate import advance, advance_drive
 
-__all__ = ['rates', 'every', 'cart_windows', 'angle_windows', 'drive_states', 'applied_commands', 'predict',
+__all__ = ['every', 'cart_windows', 'angle_windows', 'drive_states', 'applied_commands', 'predict',
            'reading_errors', 'summary', 'window_sse']
 
 CART_WINDOW_S = 1.0
@@ -51,21 +50,10 @@ class Windows:
     state: np.ndarray     # (n, 5): x, theta, x', theta', z=0 at the start
     held: np.ndarray      # (n,): 1.0 where the cart stood still at the start
     forced: np.ndarray    # (n_samples, 2) measured angle and rate the simulation follows, or (0, 2)
-    motion: np.ndarray    # (n_samples, 2) measured cart speed [m/s] and acceleration [m/s^2] (:func:`rates`)
+    motion: np.ndarray    # (n_samples, 2) measured cart speed [m/s] and acceleration [m/s^2] (smooth_rate)
 
     def __len__(self) -> int:
         return len(self.start)
-
-
-def rates(t: np.ndarray, y: np.ndarray, valid: np.ndarray) -> np.ndarray:
-    """dy/dt of an encoder signal along the record [unit/s]: zero-phase 4th-order Butterworth at
-    FILTER_HZ on a uniform grid (the record's median period), differentiated, read back at ``t``."""
-    dt = float(np.median(np.diff(t)))
-    grid = np.arange(t[0], t[-1] + 0.5 * dt, dt)
-    yg = np.interp(grid, t[valid], y[valid])
-    cutoff = min(FILTER_HZ, 0.4 / dt)
-    f = sosfiltfilt(butter(4, cutoff, fs=1.0 / dt, output='sos'), yg)
-    return np.interp(t, grid, np.gradient(f, dt))
 
 
 def local_rate(t: np.ndarray, y: np.ndarray, k: int, valid: np.ndarray, half_s: float = 0.01) -> float:
@@ -100,7 +88,8 @@ def make_windows(rec: Record, length_s: float, forced: bool = False, span: float
     cart to the next where it can (its state is then known: at rest, held by static friction;
     a window may reach ``span`` times its length for it), else from the measured state with
     velocities from :func:`local_rate`. With
-    ``forced``, the angle follows the measurement in them (its rate: :func:`rates`)."""
+    ``forced``, the angle follows the measurement in them (its rate:
+    :func:`~ipfric_core.analysis.records.smooth_rate`)."""
     t, x = rec.t, rec.x
     valid = rec.valid_mask & (t >= t[0] + LEAD_S)
     th = rec.theta if rec.theta is not None else np.zeros_like(x)
@@ -122,6 +111,7 @@ def make_windows(rec: Record, length_s: float, forced: bool = False, span: float
                 lo = int(np.searchsorted(t, t[k] + 0.5 * length_s))
                 r = np.flatnonzero(rest[lo:end])
                 end = lo + int(r[-1]) + 1 if len(r) and end < b else end
+            end = max(end, k + 2)          # a window holds two samples at least: the loop always advances
             starts.append(k)
             stops.append(end)
             k = end - 1
@@ -131,8 +121,8 @@ def make_windows(rec: Record, length_s: float, forced: bool = False, span: float
     w = (np.array([local_rate(t, th, k, rec.valid_mask) for k in start]) if rec.theta is not None
          else np.zeros(len(start)))
     state = np.column_stack([x[start], th[start], v, w, np.zeros(len(start))])
-    angle = (np.column_stack([th, rates(t, th, rec.valid_mask)]) if forced else np.zeros((0, 2)))
-    speed = rates(t, x, rec.valid_mask)
+    angle = (np.column_stack([th, smooth_rate(t, th, rec.valid_mask, FILTER_HZ)]) if forced else np.zeros((0, 2)))
+    speed = smooth_rate(t, x, rec.valid_mask, FILTER_HZ)
     return Windows(start, stop, state, held, angle, np.column_stack([speed, np.gradient(speed, t)]))
 
 
@@ -190,14 +180,15 @@ def drive_states(pp, gap, mass, t, u, motion):
 
 @compiled(parallel=True)   # the windows are independent: one thread each
 def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, drive0, t, first, durations, commands,
-           start, stop, state, held, substep, forced, out):
+           start, stop, state, held, substep, forced, angle, out):
     """Encoder readings (x, theta) predicted in every window, written into ``out`` (n, 2). Each
     sample interval k is integrated over its pieces of constant applied command (``first``,
     ``durations``, ``commands`` of :func:`~ipfric_core.physics.rig.delayed_pieces`), each through
     the input effects. Without a pendulum (pp's m = 0) the angle is held at 0; with ``forced`` (n, 2)
-    rows, the angle and its rate are set to them (less the bias) after every sample. With a drive
-    play (``drive`` as :func:`~ipfric_core.physics.simulate.advance_drive` takes it, play > 0) each
-    window starts from the drive state ``drive0`` (n_windows, 2+) of :func:`drive_states`."""
+    rows, the angle and its rate are set to them (less the bias) after every sample; a free angle more
+    than 1.5 rad from the measured one (``angle``) has diverged (the rest of its window is NaN). With a
+    drive play (``drive`` as :func:`~ipfric_core.physics.simulate.advance_drive` takes it, play > 0)
+    each window starts from the drive state ``drive0`` (n_windows, 2+) of :func:`drive_states`."""
     pendulum = pp[1] > 0.0
     force = len(forced) > 0
     for w in numba.prange(len(start)):
@@ -221,7 +212,7 @@ def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, drive0, t, 
                 s = (s[0], forced[k + 1, 0] - theta_bias, s[2], forced[k + 1, 1], s[4])
             elif not pendulum:
                 s = (s[0], 0.0, s[2], 0.0, s[4])
-            if not (math.isfinite(s[0]) and math.isfinite(s[1])) or abs(s[1]) > 1.5:
+            if not (math.isfinite(s[0]) and math.isfinite(s[1])) or abs(s[1] + theta_bias - angle[k + 1]) > 1.5:
                 for j in range(k + 1, stop[w]):
                     out[j, 0], out[j, 1] = np.nan, np.nan
                 break
@@ -257,7 +248,8 @@ def predict(model, rec: Record, win: Windows) -> Prediction:
               if drive[0] > 0.0 else np.zeros((len(win), 3)))
     _shoot(model.pp, model.fp, tr.force_vector(), tr.deadzone_V, tr.saturation_V, tr.backlash_m, tr.bias_theta_rad,
            drive, drive0, rec.t, first, durations, np.ascontiguousarray(commands, float), win.start, win.stop,
-           win.state, win.held, min(1e-3, float(np.median(np.diff(rec.t)))), win.forced, out)
+           win.state, win.held, min(1e-3, float(np.median(np.diff(rec.t)))), win.forced,
+           rec.theta if rec.theta is not None else np.zeros(len(rec.t)), out)
     window_of = np.full(len(rec.t), -1)
     for i, (a, b) in enumerate(zip(win.start, win.stop)):
         window_of[a + 1:b] = i
