@@ -17,7 +17,6 @@ from __future__ import annotations
 import csv
 import gzip
 import io
-import math
 from array import array
 from dataclasses import dataclass, field, replace
 from pathlib import Path
