@@ -102,8 +102,8 @@ def swinging_pendulum(hanging: bool, l: float = 0.3, g: float = 9.8):
     for k in range(n):
         xs[k], ths[k] = x, th
         if hanging:
-            a = -(2 * np.pi * 1.3) ** 2 * 0.02 * np.sin(2 * np.pi * 1.3 * t[k]) - (2 * np.pi * 3.1) ** 2 * 0.01 * np.sin(
-                2 * np.pi * 3.1 * t[k])
+            w1, w2 = 2 * np.pi * 1.3, 2 * np.pi * 3.1
+            a = -w1 ** 2 * 0.02 * np.sin(w1 * t[k]) - w2 ** 2 * 0.01 * np.sin(w2 * t[k])
         else:
             a = 2 * g * th + 0.5 * w + 1.5 * np.sin(2 * np.pi * 1.7 * t[k])
         w += h * 0.75 * (g * np.sin(th) - a * np.cos(th)) / l
