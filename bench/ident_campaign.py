@@ -123,6 +123,7 @@ def identify_case(case_dir: Path, truth: dict, timeout: float = TIMEOUT) -> dict
     env = dict(os.environ, OPENBLAS_NUM_THREADS='1', MKL_NUM_THREADS='1')
     (case_dir / 'ident').mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
+    rc: int | str
     try:
         proc = subprocess.run([sys.executable, '-m', 'ipfric_core.cli', *cmd], cwd=ROOT, env=env,
                               capture_output=True, text=True, timeout=timeout)
@@ -227,7 +228,7 @@ def detection_limit(points: list[tuple[float, bool]], share: float = 0.95, least
 
 
 def summarize(cases: list[dict], threshold: float, meta: dict) -> dict:
-    confusion = defaultdict(Counter)
+    confusion: defaultdict[str, Counter] = defaultdict(Counter)
     for c in cases:
         confusion[c['expected']][c['predicted']] += 1
     per_effect = defaultdict(list)        # name -> [(counts, named right, answer)]
@@ -242,9 +243,9 @@ def summarize(cases: list[dict], threshold: float, meta: dict) -> dict:
     for name, pts in sorted(per_effect.items()):
         bins = []
         for lo, hi in zip(BINS[:-1], BINS[1:]):
-            sel = [ok for cnt, ok, *_ in pts if lo <= cnt < hi]
-            if sel:
-                bins.append(dict(lo=lo, hi=hi, n=len(sel), named=int(sum(sel)), rate=sum(sel) / len(sel)))
+            hits = [ok for cnt, ok, *_ in pts if lo <= cnt < hi]
+            if hits:
+                bins.append(dict(lo=lo, hi=hi, n=len(hits), named=int(sum(hits)), rate=sum(hits) / len(hits)))
         above = [ok for cnt, ok, *_ in pts if cnt >= threshold]
         instead = Counter(ans for cnt, ok, ans, _ in pts if cnt >= threshold and not ok)
         rates[name] = dict(

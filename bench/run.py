@@ -221,7 +221,8 @@ def _analyze(bag: Path) -> tuple[float, float, int]:
     cmd = [sys.executable, '-m', 'ipfric_core.cli', 'analyze', str(bag), '--no-plots', '--json']
     t0 = time.perf_counter()
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
-    out = proc.communicate()[0]
+    assert proc.stdout is not None
+    out = proc.stdout.read()
     _, status, usage = os.wait4(proc.pid, 0)
     wall = time.perf_counter() - t0
     if status != 0:

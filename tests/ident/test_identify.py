@@ -140,7 +140,8 @@ def test_cli_csv_report_and_export(tmp_path, clean, capsys):
     assert main(['identify', str(csv), '--base', 'coulomb', '--out', str(tmp_path / 'rep'), '--json',
                  '--export', str(tmp_path / 'identified.yaml')]) == 0
     r = json.loads(capsys.readouterr().out)
-    assert [s['step'] for s in r['ladder']][:2] == ['declared', 'refit']
+    # the data are the declared model's (Table 2): explained as declared, nothing fitted or added
+    assert [s['step'] for s in r['ladder']] == ['declared'] and r['verdict']['explained'], r['verdict']
     for s in r['ladder']:
         assert {'x_rms_counts', 'x_percent'} <= set(s['validation'])
         assert {p['name'] for p in s['params']} >= {'M', 'alpha', 'beta', 'Fc', 'Fs_excess', 'eps'}

@@ -300,7 +300,8 @@ def check_record(rec: Record, angle_zero: str = 'auto') -> Record:
         if np.max(np.abs(theta)) > 2 * np.pi and off_axis > 0.5:
             raise ConfigError(f'{rec.name}: column theta reaches {np.max(np.abs(theta)):g}; expected radians '
                               f'from upright or from hanging (degrees?)')
-        theta, found = upright_angle(rec.t, rec.x, theta, rec.pendulum[1], rec.pendulum[2], angle_zero)
+        _, length, gravity = rec.pendulum if rec.pendulum is not None else (0.0, 1.0, 9.81)
+        theta, found = upright_angle(rec.t, rec.x, theta, length, gravity, angle_zero)
         notes += found
     valid = overruns(rec.t, [rec.x] + ([theta] if theta is not None else []))
     gaps = np.flatnonzero(d > max(GAP_PERIODS * period, GAP_S)) + 1

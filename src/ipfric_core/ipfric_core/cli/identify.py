@@ -8,6 +8,7 @@ from pathlib import Path
 
 from ..analysis.records import parse_columns
 from ..design.paperconfig import DEFAULT_DATA
+from ..ident.free_run import INIT_SAMPLES
 from ..ident.identify import SPLIT_RANGE, identify_record, identify_tables
 from ..ident.ladder_report import correlation_lines
 from ..ident.redesign import close_the_loop
@@ -18,19 +19,24 @@ __all__ = ['NAME', 'HELP', 'add_arguments', 'main']
 
 NAME = 'identify'
 HELP = ('identify the cart\'s friction and undeclared effects from measured data (run bag, CSV, EMPS .mat, or '
-        '"paper" for Tables 5-6): base fit, residual analysis, greedy effect search kept only when it pays on '
-        'validation data; report, export, redesign')
+        '"paper" for Tables 5-6): the declared model and competing hypotheses (refit, laws, plant corrections, '
+        'effects) judged by simulation error on validation data, a verdict against the encoders\' floor; '
+        'report, export, redesign')
 
 
 def add_arguments(i) -> None:
     i.add_argument('data', nargs='?', default='paper', help='run directory / bag / .mcap, .csv (t,x,voltage[,theta]), '
                    'EMPS .mat, or "paper" (default %(default)s)')
     i.add_argument('--validation', help='second file for validation (default: the last part of DATA)')
+    i.add_argument('--test', help='a held-out file the final model runs free over, from its first --test-init '
+                   'readings (the nonlinear benchmarks\' protocol); reports the position RMS error in mm')
+    i.add_argument('--test-init', type=int, default=INIT_SAMPLES, help='readings that initialise the --test run '
+                   '(default %(default)s, EMPS\'s state_initialization_window_length)')
     i.add_argument('--split', type=float, default=0.6, help='estimation share of DATA when no --validation, in '
                    f'[{SPLIT_RANGE[0]:g}, {SPLIT_RANGE[1]:g}] (default %(default)s)')
-    i.add_argument('--base', default='exponential', help='declared friction law: viscous, coulomb, exponential '
-                   '(the paper\'s values, unless --plant gives them); dynamic for a force-input record such as '
-                   'EMPS (default %(default)s)')
+    i.add_argument('--base', default='exponential', help='declared friction law: viscous, coulomb, exponential, '
+                   'dynamic (the paper\'s values, unless --plant gives them; for a force-input record such as EMPS '
+                   'the law its force balance fits) (default %(default)s)')
     i.add_argument('--free', help='known plant constants to fit too, e.g. M,alpha (default: none; they stay '
                    'as declared)')
     i.add_argument('--effects', help='comma-separated candidate effects (default: the whole library)')
@@ -90,23 +96,6 @@ def fmt_param(p: dict) -> str:
     return f'{p["value"]:.4g}{std} {p["unit"]}'.rstrip()
 
 
-def print_force_input(r: dict) -> None:
-    """A force-input record's equation-error result, with the simulation error of its model."""
-    print(f'{r["data"]["estimation"]} / {r["data"]["validation"]}: base {r["base_model"]}, effects added: '
-          f'{", ".join(r["effects_added"]) or "none"}')
-    for tag in ('error_before', 'error_after'):
-        e = r[tag]
-        print(f'  {tag.replace("_", " "):<13} estimation {e["estimation"]["relative_percent"]:.3f} % '
-              f'(RMS {e["estimation"]["rms"]:.4g} N), validation {e["validation"]["relative_percent"]:.3f} % '
-              f'(RMS {e["validation"]["rms"]:.4g} N)')
-    sim = r['simulation_error']
-    print(f'  simulation error (validation): {sim["x_rms_counts"]:.3g} counts, {sim["x_percent"]:.3g} % of the motion')
-    for t in r['effects_tried']:
-        print(f'  tried {t["name"]:<11} validation gain {t["validation_gain_percent"]:7.2f} %  '
-              f'p {t["validation_p"]:.2g}  {"kept" if t["kept"] else "rejected"}')
-    print('  ' + ', '.join(f'{k} {p["value"]:.5g} +/- {p["std"]:.2g} {p["unit"]}' for k, p in r['params'].items()))
-
-
 def print_ladder(r: dict) -> None:
     """The ladder's steps, notes, final parameters and correlations."""
     print(f'{r["data"]["estimation"]} / {r["data"]["validation"]}: effects added: '
@@ -127,6 +116,23 @@ def print_ladder(r: dict) -> None:
     if rough:
         print(f'  the simulated error is rough in {", ".join(rough)}: their errors come from a scan of the error '
               f'along each')
+    for rd in r['rounds']:
+        ru = rd['runner_up']
+        if ru:
+            print(f'  round {rd["round"]}: kept {rd["kept"] or "nothing"}; runner-up {ru["hypothesis"]} '
+                  f'({ru["validation_x_rms_counts"]:.3g} counts)')
+    for f in r.get('force_error', []):
+        print(f'  {f["step"]:<14} relative force error: estimation {f["estimation"]["relative_percent"]:.3f} %, '
+              f'validation {f["validation"]["relative_percent"]:.3f} %')
+    if 'test' in r:
+        t = r['test']
+        print(f'  test {t["record"]}: run free from its first {t["init_samples"]} readings, position RMS error '
+              f'{t["rmse_mm"]:.4g} mm over {t["samples"]} readings')
+    v = r['verdict']
+    print(f'  {v["reason"]}')
+    for t in [] if v['explained'] else v.get('largest_left', []):
+        print(f'    left: {t["hypothesis"]} lowers it {t["validation_gain_percent"]:.3g} %, refused: '
+              f'{"; ".join(t["refused"])}')
 
 
 def main(args) -> int:
@@ -137,14 +143,11 @@ def main(args) -> int:
     say = None if args.json else (lambda msg: print(msg, file=sys.stderr))
     r = identify_record(args.data, args.out, args.plant, args.base, args.free, args.effects,
                         parse_columns(args.columns), args.cart_alone, args.validation, args.split,
-                        not args.no_plots, args.export, args.scenario, args.rig, say)
+                        not args.no_plots, args.export, args.scenario, args.rig, say, args.test, args.test_init)
     if args.json:
         print_json(r)
         return 0
-    if 'ladder' in r:
-        print_ladder(r)
-    else:
-        print_force_input(r)
+    print_ladder(r)
     print(f'  report {r["files"]["report"]}')
     if 'export' in r:
         print(f'  exported {r["export"]["scenario"]}' + (f' and {r["export"]["on_rig"]}' if 'on_rig' in r['export']

@@ -20,7 +20,7 @@ import numpy as np
 from ..physics.friction import DYNAMIC, FP_ASYM, bristle_path, friction_forces, friction_vector, static_limit
 from ..physics.params import FRICTION_FIELDS, PLANT_FIELDS, FrictionParams
 from ..physics.plant import undeclared_forces
-from ..physics.rig import PLANT_TRUTH_FIELDS, delayed_means, inputs_through
+from ..physics.rig import PLANT_TRUTH_FIELDS, drive_means, inputs_through
 
 __all__ = ['ParamSpec', 'PARAMS', 'Effect', 'BASE_PARAMS', 'EFFECTS', 'BASE_MODELS', 'effective_input', 'plateaus',
            'dwell_profile', 'fitted_friction_vector', 'static_levels', 'position_force', 'resisting_force']
@@ -64,8 +64,9 @@ PARAMS: dict[str, ParamSpec] = {p.name: p for p in (
     *(_schema(PLANT_TRUTH_FIELDS, k, v) for k, v in (
         ('cogging_sin_N', 0.1), ('cogging_cos_N', 0.1), ('cogging_period_m', 0.01), ('offset_N', 0.1),
         ('asymmetry', 0.2), ('asymmetry_viscous_Ns_per_m', 1.0), ('deadzone_V', 0.1), ('saturation_V', 5.0),
-        ('input_delay_s', 0.01), ('backlash_m', 1e-3), ('drive_backlash_m', 1e-3), ('drive_mass_kg', 0.2),
-        ('drive_stiffness_N_per_m', 1e5), ('drive_damping_Ns_per_m', 20.0), ('bias_theta_rad', 0.005))),
+        ('input_delay_s', 0.01), ('input_lag_s', 0.01), ('backlash_m', 1e-3), ('drive_backlash_m', 1e-3),
+        ('drive_mass_kg', 0.2), ('drive_stiffness_N_per_m', 1e5), ('drive_damping_Ns_per_m', 20.0),
+        ('bias_theta_rad', 0.005))),
 )}
 
 
@@ -123,8 +124,11 @@ EFFECTS = {e.name: e for e in (
     Effect('saturation', ('saturation_V',), 'input', 'voltage',
            'the drive clips |u| at saturation_V: the residual grows with |u| beyond it'),
     Effect('delay', ('input_delay_s',), 'input', 'lag',
-           'transport delay between command and force (physics.rig.delayed_pieces): the residual correlates '
+           'transport delay between command and force (physics.rig.drive_pieces): the residual correlates '
            'with the input\'s rate at a lag'),
+    Effect('lag', ('input_lag_s',), 'input', 'lag',
+           'first-order lag between the command and the force (an amplifier, a motor current loop; '
+           'physics.rig.lag_response): the force answers a step of the command over input_lag_s'),
     Effect('sensor_bias', ('bias_theta_rad',), 'sensor', 'pendulum_mean',
            'constant angle-encoder offset: the pendulum equation (4/3) l theta\'\' = g sin(theta) - '
            'x\'\' cos(theta) has a mean residual of about g * bias', needs_theta=True),
@@ -138,10 +142,11 @@ BASE_MODELS = {
 
 
 def effective_input(t: np.ndarray, u: np.ndarray, p: dict, active) -> np.ndarray:
-    """u_eff: the input after delay (its mean over each sample interval), deadzone and saturation (same
-    unit as u), the rig's law."""
-    if 'delay' in active:
-        u = delayed_means(t, u, p['input_delay_s'])
+    """u_eff: the input after delay and lag (their mean over each sample interval), deadzone and saturation
+    (same unit as u), the rig's law."""
+    if 'delay' in active or 'lag' in active:
+        u = drive_means(t, u, p['input_delay_s'] if 'delay' in active else 0.0,
+                        p['input_lag_s'] if 'lag' in active else 0.0)
     if 'deadzone' in active or 'saturation' in active:
         u = inputs_through(np.ascontiguousarray(u, float), p['deadzone_V'] if 'deadzone' in active else 0.0,
                            p['saturation_V'] if 'saturation' in active else 0.0)

@@ -1,4 +1,5 @@
-"""Identification of the cart's force balance with a greedy search over effects.
+"""The cart's force balance by equation error: what starts the ladder on a force-input record that
+declares no plant, the force error of a model, and the signatures of what a model leaves.
 
 Equation error on filtered derivatives: position and input are low-pass filtered with
 a zero-phase Butterworth filter (corner ``Record.cutoff_hz``), differentiated, and
@@ -12,17 +13,14 @@ static friction enters as inequalities on the stretches where the encoder stands
 (held force <= Fs while stuck, >= Fs at the breakaway). With the pendulum, its own
 equation (no unknown parameter) is a further residual block.
 
-Search (:func:`identify`): fit the base model; then, round by round, refit with each
-remaining candidate effect, rank the candidates by how much estimation error each
-removes, and keep the best only if it pays on the validation data: the Bayesian
-information criterion on estimation drops, the validation RMS drops by more than
-``min_gain_percent``, and the drop is significant (p < P_VALUE in a block bootstrap
-over quarter-second blocks), and the effect is resolvable (:func:`resolved`). Stop when
-the residual is white or nothing pays.
+:func:`base_fit` fits a friction law's force balance (mass, viscous slope, the law's levels);
+:func:`force_error` is the relative force error of a model (the EMPS benchmark's metric);
+:func:`signatures_left` scores the model's force residual against the signatures of
+:mod:`ipfric_core.ident.residual` (what the residual follows: the direction of motion, the
+position, the input, ...).
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,15 +31,10 @@ from ..analysis.records import Record
 from ..physics.params import ConfigError
 from ..physics.plant import held_forces, pendulum_residuals, required_forces
 from . import effects as fx
-from .residual import signature_scores, whiteness
+from .residual import signature_scores
 
-__all__ = ['P_VALUE', 'BOOTSTRAP', 'balance', 'param_specs', 'errors', 'analyse', 'identify', 'identify_steady',
-           'model_vectors']
+__all__ = ['base_fit', 'force_error', 'signatures_left', 'identify_steady']
 
-MIN_GAIN_PERCENT = 1.0
-P_VALUE = 0.01
-BLOCK_S = 0.25
-BOOTSTRAP = 2000
 EDGE_S = 0.15
 TICK_S = 0.02
 STUCK_S = 0.05  # an encoder standing still this long [s] shows a stuck cart
@@ -149,7 +142,8 @@ def balance(pr: Prepared, p: dict, active) -> Balance:
     else:
         uf_full = pr.uf_full
     uf = uf_full[pr.idx]
-    y = rec.gain * uf
+    gain = p.get('alpha', rec.gain)
+    y = gain * uf
     x, v, a = pr.x, pr.v, pr.a
     if 'backlash' in active:
         g = p['backlash_m']
@@ -157,7 +151,7 @@ def balance(pr: Prepared, p: dict, active) -> Balance:
     pp = fitted_plant_vector(rec, p)
     th = pr.th - p.get('bias_theta_rad', 0.0) if pr.has_theta else np.zeros_like(a)
     thd = pr.thd if pr.has_theta else np.zeros_like(a)
-    model = required_forces(pp, a, th, thd) + rec.back_emf * v + fx.resisting_force(x, v, p, active, pr.dt)
+    model = required_forces(pp, a, th, thd) + pp[5] * v + fx.resisting_force(x, v, p, active, pr.dt)
     pend = pendulum_residuals(pp, a, th, pr.thdd) if pr.has_theta else None
     used = pr.used
     static = np.zeros(0)
@@ -165,7 +159,7 @@ def balance(pr: Prepared, p: dict, active) -> Balance:
         # held force: input less the pendulum's reaction and the track forces, with the cart at rest
         # (filtered like the rest: a command spike too short to move the cart past one count is
         # smoothed as the cart's inertia smooths it)
-        held = rec.gain * uf_full[pr.b_idx] - fx.position_force(pr.b_x, p, active)
+        held = gain * uf_full[pr.b_idx] - fx.position_force(pr.b_x, p, active)
         if pr.has_theta:
             held = held_forces(pp, pr.b_th - p.get('bias_theta_rad', 0.0), pr.b_thd, held)
         # stuck: static friction held it, held within the static levels; breakaway: beyond them (eq. 5)
@@ -179,9 +173,11 @@ def balance(pr: Prepared, p: dict, active) -> Balance:
 
 def fitted_plant_vector(rec: Record, p: dict) -> tuple:
     """The plant vector of :mod:`ipfric_core.physics.plant` with the fitted mass: (M, m, l, g,
-    gain, back-EMF), the pendulum's (m, l, g) when attached, else m = 0."""
+    gain, back-EMF; the record's unless ``p`` holds alpha and beta), the pendulum's (m, l, g) when
+    attached, else m = 0."""
     m, l, g = rec.pendulum if rec.pendulum is not None else (0.0, 1.0, 9.8)
-    return (float(p['M']), float(m), float(l), float(g), float(rec.gain), float(rec.back_emf))
+    return (float(p['M']), float(m), float(l), float(g), float(p.get('alpha', rec.gain)),
+            float(p.get('beta', rec.back_emf)))
 
 
 def residual_vector(pr: Prepared, p: dict, active) -> np.ndarray:
@@ -202,11 +198,6 @@ class Fit:
     params: dict
     std: dict
     cost: float        # mean squared residual [N^2] over the used samples (+ pendulum block)
-    n: int
-
-    @property
-    def bic(self) -> float:
-        return self.n * math.log(max(self.cost, 1e-300)) + len(self.params) * math.log(self.n)
 
 
 def fit(pr: Prepared, active, start: dict) -> Fit:
@@ -236,7 +227,7 @@ def fit(pr: Prepared, active, start: dict) -> Fit:
     except np.linalg.LinAlgError:
         std = np.full(len(names), np.nan)
     p = dict(zip(names, map(float, sol.x)))
-    return Fit(tuple(active), p, dict(zip(names, map(float, std))), float(r @ r) / n, int(n))
+    return Fit(tuple(active), p, dict(zip(names, map(float, std))), float(r @ r) / n)
 
 
 def starts(pr: Prepared, name: str, p: dict, active) -> list[dict]:
@@ -275,117 +266,43 @@ def errors(pr: Prepared, p: dict, active) -> dict:
             'samples': int(b.used.sum())}
 
 
-def resolved(pr: Prepared, name: str, f: Fit) -> bool:
-    """False for a play below two encoder counts (that is quantization), for a ripple with
-    fewer than five periods over the travel (the motion's own periodicity looks alike) and for
-    a deadzone whose force is below the residual's RMS."""
-    p = f.params
-    if name == 'deadzone':
-        return pr.rec.gain * p['deadzone_V'] > errors(pr, p, f.active)['rms']
-    if name == 'backlash':
-        return p['backlash_m'] > 2 * pr.resolution
-    if name == 'cogging':
-        return np.ptp(pr.x) >= 5 * p['cogging_period_m']
-    return True
+def base_fit(rec: Record, law: str) -> Fit:
+    """The force balance of friction law ``law`` (a key of :data:`~ipfric_core.ident.effects.BASE_MODELS`)
+    fitted to ``rec``: the mass, the viscous slope and the law's levels; viscous first (linear in them:
+    the start of the rest), then each part of the law in turn from its starts (:func:`starts`)."""
+    if law not in fx.BASE_MODELS:
+        raise ConfigError(f'base model: {law!r} is not one of {", ".join(fx.BASE_MODELS)}')
+    pe = Prepared(rec)
+    active = fx.BASE_MODELS[law]
+    start = dict(fit(pe, (), {'M': 1.0, 'eps': 0.0}).params)
+    for k, e in enumerate(active):
+        start = best_fit(pe, active[:k + 1], starts(pe, e, start, active[:k])).params
+    return fit(pe, active, start)
 
 
-def total_rms(pr: Prepared, f: Fit) -> float:
-    """RMS of everything fitted: force balance, breakaways and pendulum equation."""
-    return float(np.sqrt(np.mean(residual_vector(pr, f.params, f.active) ** 2)))
+def parts(law: str, effects) -> tuple:
+    """A model's friction law and effects as the force balance's active parts (a drive with play has a
+    hidden state the balance cannot express: left out)."""
+    return fx.BASE_MODELS[law] + tuple(e for e in effects if fx.EFFECTS[e].acts_on != 'drive')
 
 
-def block_test(pr: Prepared, before: Fit, after: Fit) -> float:
-    """p-value that the squared validation residual did not drop: block bootstrap of its drop
-    summed over time blocks of BLOCK_S seconds (the blocks keep the residual's correlation; an
-    effect confined to a few blocks, e.g. reversals, still counts by its size). Every residual
-    (force balance, static friction, pendulum) counts in its time block."""
-    r0 = residual_vector(pr, before.params, before.active)
-    r1 = residual_vector(pr, after.params, after.active)
-    d = r0 ** 2 - r1 ** 2
-    times = np.concatenate([pr.t, pr.t_full[pr.b_idx]] + ([pr.t] if pr.has_theta else []))
-    nb = max(10, min(60, int(len(pr.t) * pr.dt / BLOCK_S)))
-    block = np.minimum(((times - pr.t[0]) / (pr.t[-1] - pr.t[0] + 1e-12) * nb).astype(int), nb - 1)
-    sums = np.bincount(block, d, nb)
-    if not np.any(sums):
-        return 1.0
-    rng = np.random.default_rng(0)
-    boot = sums[rng.integers(0, nb, (BOOTSTRAP, nb))].sum(axis=1)
-    return float((np.sum(boot <= 0.0) + 1) / (BOOTSTRAP + 1))
+def force_error(rec: Record, p: dict, law: str, effects) -> dict:
+    """RMS [N] and relative error [%] = 100 ||F - F_model|| / ||F|| of a model's force balance on ``rec``
+    (its values ``p`` by name, its friction law and effects: :func:`parts`)."""
+    return errors(Prepared(rec), p, parts(law, effects))
 
 
-def analyse(pr: Prepared, f: Fit) -> dict:
-    b = balance(pr, f.params, f.active)
+def signatures_left(rec: Record, p: dict, law: str, effects) -> dict:
+    """What a model's force residual on ``rec`` follows: the share of its variance (0..1) each signature
+    of :data:`~ipfric_core.ident.residual.SIGNATURES` explains, the residual's RMS [N] and its relative size
+    (:func:`force_error`); with the period of a position signature [m] and the lag of an input one [s]."""
+    active = parts(law, effects)
+    pr = Prepared(rec)
+    b = balance(pr, p, active)
     u = b.used
-    w = whiteness(b.r[u], b.u[u])
-    s = signature_scores(b.r[u], pr.t[u], b.x[u], b.v[u], b.u[u], pr.dt,
-                         None if b.pendulum is None else b.pendulum[pr.inside])
-    return {'whiteness': w, 'signatures': s}
-
-
-def explained(pr: Prepared, f: Fit) -> bool:
-    """True when the force residual is white and static friction is not violated beyond it."""
-    b = balance(pr, f.params, f.active)
-    rms = np.sqrt(np.mean(b.r[b.used] ** 2))
-    static_ok = not len(b.static) or np.sqrt(np.mean(b.static ** 2)) <= rms
-    return bool(static_ok and analyse(pr, f)['whiteness']['white'])
-
-
-def candidate_names(pr: Prepared, base: tuple, allowed=None) -> list[str]:
-    """The effects this search can fit: a drive with play has a hidden state (the motor side
-    within the play) that a force balance on measured signals cannot express."""
-    names = [n for n in fx.EFFECTS if n not in base and (allowed is None or n in allowed)
-             and fx.EFFECTS[n].acts_on != 'drive']
-    return [n for n in names if pr.has_theta or not fx.EFFECTS[n].needs_theta]
-
-
-def identify(est: Record, val: Record, base_model: str = 'viscous', allowed=None,
-             max_rounds: int = 6, min_gain_percent: float = MIN_GAIN_PERCENT) -> dict:
-    """Fit ``base_model``, then search the effect library; returns the full result."""
-    if base_model not in fx.BASE_MODELS:
-        raise ConfigError(f'base model: {base_model!r} is not one of {", ".join(fx.BASE_MODELS)}')
-    pe, pv = Prepared(est), Prepared(val)
-    active = fx.BASE_MODELS[base_model]
-    start = {'M': 1.0, 'eps': 0.0}
-    lin = fit(pe, (), start)  # viscous first: mass and eps are linear, a good start for any base
-    start = dict(lin.params)
-    for e in active:
-        start = best_fit(pe, tuple(active[:active.index(e) + 1]), starts(pe, e, start, active[:active.index(e)])).params
-    current = fit(pe, active, start) if active else lin
-    base_fit = current
-    tried, steps = [], [current]
-    for _ in range(max_rounds):
-        if explained(pe, current):
-            break
-        ranked = []
-        for name in candidate_names(pe, current.active, allowed):
-            req = fx.EFFECTS[name].requires
-            if any(r not in current.active for r in req):
-                continue
-            act = current.active + (name,)
-            f = best_fit(pe, act, starts(pe, name, current.params, current.active))
-            ranked.append((f.cost, name, f))
-        if not ranked:
-            break
-        ranked.sort(key=lambda z: z[0])
-        kept = False
-        for _, name, f in ranked[:3]:
-            ev0, ev1 = total_rms(pv, current), total_rms(pv, f)
-            ee0, ee1 = total_rms(pe, current), total_rms(pe, f)
-            gain = 100 * (ev0 - ev1) / ev0
-            pval = block_test(pv, current, f)
-            resolvable = resolved(pe, name, f)
-            ok = bool(f.bic < current.bic and gain > min_gain_percent and pval < P_VALUE and resolvable)
-            tried.append({'name': name, 'estimation_gain_percent': 100 * (ee0 - ee1) / ee0,
-                          'validation_gain_percent': gain, 'validation_p': pval,
-                          'bic_drop': current.bic - f.bic, 'kept': ok})
-            if ok:
-                steps.append(f)
-                current, kept = f, True
-                break
-        if not kept:
-            break
-    return {'base_model': base_model, 'base_fit': base_fit, 'fit': current, 'tried': tried, 'steps': steps,
-            'prepared': (pe, pv)}
+    sig = signature_scores(b.r[u], pr.t[u], b.x[u], b.v[u], b.u[u], pr.dt,
+                           None if b.pendulum is None else b.pendulum[pr.inside])
+    return {**sig, **errors(pr, p, active)}
 
 
 def identify_steady(plant, volts, vels, breakaway_volts) -> dict:
@@ -417,13 +334,3 @@ def identify_steady(plant, volts, vels, breakaway_volts) -> dict:
             'breakaway_rms_N': float(np.sqrt(np.mean(r[len(v):] ** 2))),
             'residual_velocity_correlation': float(np.corrcoef(rs, v)[0, 1]),
             'residual_curvature_N': float(np.polyfit(v, rs, 2)[0] * np.ptp(v) ** 2 / 4)}
-
-
-def model_vectors(rec: Record, p: dict, active):
-    """The fitted force balance as the physics' arguments (:class:`ident.model.ModelVectors`), for
-    its simulation error: mass, drive gain and back-EMF as the plant, no pendulum."""
-    from ..physics.rig import PlantTruth
-    from .model import TRUTH_PARAMS, ModelVectors
-    truth = PlantTruth(**{n: p[n] for e in active if e in fx.EFFECTS for n in fx.EFFECTS[e].params
-                          if n in TRUTH_PARAMS})
-    return ModelVectors(fitted_plant_vector(rec, p), fx.fitted_friction_vector(p, active), truth)

@@ -3,9 +3,11 @@ the closed-loop redesign, each into a report directory.
 
 :func:`identify_record` reads the declared model once (:func:`~ipfric_core.ident.model.read_declared`),
 loads the record with that plant, splits it into estimation and validation parts (or takes
-a second file for validation), and runs the ladder (:mod:`ipfric_core.ident.ladder`) or, for a
-force-input record without a declared plant (EMPS), the equation-error search
-(:mod:`ipfric_core.ident.equation_error`); the report is written into the output directory,
+a second file for validation), and runs the ladder (:mod:`ipfric_core.ident.ladder`). A
+force-input record that declares no plant (EMPS: the force is gain * u) starts the ladder from
+its force balance (:func:`force_input_model`), and its report adds the relative force error of
+each step (the EMPS benchmark's metric). With a test record, the final model is also run free
+over it (:mod:`ipfric_core.ident.free_run`). The report is written into the output directory,
 and the identified rig exported as a scenario when asked.
 """
 from __future__ import annotations
@@ -13,19 +15,19 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
-from ..analysis.records import load
+from ..analysis.records import Record, load
 from ..design.estimation import load_table5, load_table6
-from ..physics.params import ConfigError, PlantParams
+from ..physics.params import ConfigError, FrictionParams, PlantParams
 from ..run.scenario import DEFAULT_SCENARIO, load_scenario
 from .effects import EFFECTS
-from .equation_error import identify, identify_steady
+from .equation_error import base_fit, force_error, identify_steady
+from .free_run import INIT_SAMPLES, free_run
 from .ladder import run_ladder
 from .ladder_report import write_ladder_report
-from .model import declared, read_declared
+from .model import Model, declared, read_declared
 from .redesign import export_scenario
-from .report import write_report
 
-__all__ = ['SPLIT_RANGE', 'candidate_effects', 'identify_tables', 'identify_record']
+__all__ = ['SPLIT_RANGE', 'candidate_effects', 'identify_tables', 'force_input_model', 'identify_record']
 
 #: the estimation share of a record split in time
 SPLIT_RANGE = (0.2, 0.9)
@@ -53,34 +55,64 @@ def identify_tables(tables: str | Path, plant_file: str | Path | None = None) ->
     return rep
 
 
+def force_input_model(rec: Record, law: str) -> Model:
+    """The declared model of a force-input record that declares no plant (EMPS): the mass and the law's
+    friction of its force balance (:func:`~ipfric_core.ident.equation_error.base_fit`), the record's gain
+    as alpha and its back-EMF as beta, the cart alone. The ladder takes it as its hypothesis."""
+    f = base_fit(rec, law).params
+    plant = PlantParams(M=f['M'], alpha=rec.gain, beta=rec.back_emf)
+    fn = plant.M * plant.g
+    fc = f.get('Fc', 0.0)
+    friction = FrictionParams(model=law, eps=f['eps'], mu_c=fc / fn, mu_s=(fc + f.get('Fs_excess', 0.0)) / fn,
+                              **{k: f[k] for k in ('v_s', 'sigma0', 'sigma1') if k in f})
+    return declared(plant, friction, False)
+
+
+def force_errors(res: dict) -> list[dict]:
+    """The relative force error of each step of a ladder on its estimation and validation records."""
+    out = []
+    for s in res['steps']:
+        p = {q.name: q.value for q in s.model.params}
+        out.append({'step': s.label, **{part: force_error(res[part], p, s.model.law, s.model.effects)
+                                        for part in ('estimation', 'validation')}})
+    return out
+
+
 def identify_record(data: str | Path, out: str | Path, plant_file: str | Path | None = None,
                     base: str = 'exponential', free: str | None = None, effects: str | None = None,
                     columns: dict | None = None, cart_alone: bool = False, validation: str | Path | None = None,
                     split: float = 0.6, plots: bool = True, export: str | Path | None = None,
                     scenario: str | Path | None = None, rig: str | Path | None = None,
-                    progress: Callable[[str], None] | None = None) -> dict:
+                    progress: Callable[[str], None] | None = None, test: str | Path | None = None,
+                    test_init: int = INIT_SAMPLES) -> dict:
     """Identify the record ``data`` (a bag or run directory, a CSV, an EMPS .mat) against the declared
     model of ``plant_file`` and write the report into ``out``; the result (``result.json``'s content).
 
     ``free``: known constants to fit too ('M,alpha'); ``effects``: the candidate effects ('a,b', default
-    all); ``validation``: a second file to judge on, else the last 1 - ``split`` of ``data``; ``export``:
-    write the identified rig as a scenario (settings, Q and R of ``scenario``; with ``rig``, also that
-    rig with the new gain)."""
+    all); ``validation``: a second file to judge on, else the last 1 - ``split`` of ``data``'s motion;
+    ``test``: a held-out file the final model runs free over from its first ``test_init`` readings;
+    ``export``: write the identified rig as a scenario (settings, Q and R of ``scenario``; with ``rig``,
+    also that rig with the new gain)."""
     allowed = candidate_effects(effects)
     plant, friction = read_declared(plant_file, base)
     rec = load(data, plant, columns, cart_alone)
-    if validation:
-        est, val = rec, load(validation, plant, columns, cart_alone)
+    if not SPLIT_RANGE[0] <= split <= SPLIT_RANGE[1]:
+        raise ConfigError(f'--split: {split:g} is out of range; allowed [{SPLIT_RANGE[0]:g}, {SPLIT_RANGE[1]:g}]')
+    held_out = load(test, plant, columns, cart_alone) if test else None
+    est, val = (rec, load(validation, plant, columns, cart_alone)) if validation else rec.split(split)
+    force_input = plant is None and rec.plant is None
+    if force_input:
+        model = force_input_model(est, base)
     else:
-        if not SPLIT_RANGE[0] <= split <= SPLIT_RANGE[1]:
-            raise ConfigError(f'--split: {split:g} is out of range; allowed [{SPLIT_RANGE[0]:g}, {SPLIT_RANGE[1]:g}]')
-        est, val = rec.split(split)
-    if Path(data).suffix.lower() == '.mat':
-        return write_report(identify(est, val, base, allowed), out, plots)
-    model = declared(plant or rec.plant or PlantParams(), friction, rec.theta is not None)
+        model = declared(plant or rec.plant or PlantParams(), friction, rec.theta is not None)
     if free:
         model = model.freeing([n.strip() for n in free.split(',')])
-    r = write_ladder_report(run_ladder(est, val, model, allowed, progress), out, plots)
+    res = run_ladder(est, val, model, allowed, progress)
+    if force_input:
+        res['force_error'] = force_errors(res)
+    if held_out is not None:
+        res['test'] = free_run(res['steps'][-1].model, held_out, test_init)
+    r = write_ladder_report(res, out, plots)
     if export:
         r['export'] = export_scenario(export, r['ladder'][-1]['step'], r['identified'],
                                       load_scenario(scenario or DEFAULT_SCENARIO),

@@ -31,13 +31,14 @@ Fits are bounded least squares (``scipy.optimize.least_squares``) on parameters 
 their typical size, with finite-difference Jacobians (:mod:`ipfric_core.ident.lsq`; they end
 when a step gains less than ``lsq.FTOL``); standard errors come from the Jacobian at the end (in the
 scaled parameters), inflated for the correlation of the errors within a window (the effective
-sample count is the number of windows), and from a scan along a parameter where the error is
+sample count is the number of windows, each block of windows with its own level: :func:`block_covariance`),
+and from a scan along a parameter where the error is
 rough in it or rises slower than a quadratic (:class:`Errors`, :func:`lsq.scan_errors`).
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -45,15 +46,25 @@ from ..analysis.records import Record, smooth_rate
 from ..physics.params import ConfigError
 from . import lsq, shooting
 from .effects import EFFECTS, PARAMS
-from .equation_error import BOOTSTRAP, P_VALUE
-from .model import LADDER_EFFECTS, Model
+from .model import FRICTION_FITTED, LADDER_EFFECTS, LAW_PARAMS, Model
 
 __all__ = ['Problem', 'Step', 'run_ladder']
 
+P_VALUE = 0.01           # a drop is significant below this p-value
+BOOTSTRAP = 2000         # resamples of the windows' drops (:func:`block_p_value`)
 SIM_GAIN_PERCENT = 2.0
 MIN_DROP_COUNTS = 0.05   # and by at least this much RMS [counts] (rounding alone leaves 0.29 count)
 WORSE_PERCENT = 5.0      # a reported figure (cart, angle) may not rise by more (their noise floors move a little)
-MAX_ROUNDS = 3
+MAX_ROUNDS = 4
+#: the friction laws the ladder weighs against each other
+LAWS = ('viscous', 'coulomb', 'exponential', 'dynamic')
+#: the declared plant constants the ladder may correct (an effective mass with the rotor reflected, the motor)
+PLANT_CORRECTIONS = ('M', 'alpha', 'beta')
+CONTRIBUTION_COUNTS = 2.0  # a kept hypothesis changes the simulated motion by this much at least [counts RMS]
+#: the data are explained when the error is within this factor of what the encoders' rounding alone
+#: leaves, plus this many counts
+EXPLAINED_FACTOR = 1.5
+EXPLAINED_SLACK = 0.3
 MAX_NFEV = 40
 DIFF_STEP = 5e-3
 THETA_WEIGHT = 0.2       # an angle count weighs a fifth of a cart count (errors of the pendulum's start rates grow)
@@ -65,11 +76,12 @@ SCREEN_GAIN = 0.01       # an effect whose own parameters lower the estimation c
 #: effects started from a grid of their error: when its best point lowers the cart's estimation cost by
 #: less than SCREEN_GAIN, they are not fitted (a drive play's simulation costs tens of ordinary ones)
 GRID_SCREENED = ('drive_backlash',)
-#: the candidates' fits use windows spread over the estimation record, up to this many samples per
-#: block (a 2-minute record at 1 kHz: every second window); the kept effect is refitted on all
-SCREEN_SAMPLES = 30000
+#: the candidates' short fits use windows spread over the estimation record, up to this many samples per
+#: block (a 2-minute record at 1 kHz: every seventh window); the kept explanation is refitted on all
+SCREEN_SAMPLES = 10000
 SCREEN_NFEV = 12         # steps of a candidate's short fit
 FULL_SHARE = 0.5         # a candidate is fitted in full when its short fit gains this share of the best one's
+FULL_TOP = 3             # and is among the best FULL_TOP of its group
 REDO_GAIN = 0.1          # a short fit that gains this much on a subset of windows and nothing on all is redone on all
 
 class Problem:
@@ -199,14 +211,10 @@ def fit_model(pr: Problem, model: Model, max_nfev: int = MAX_NFEV, only=None, pr
     fitted = model.with_values(dict(zip(names, sol.x * scale)))
     if not errors:
         return fitted, {}
-    n = len(sol.fun)
-    # one standard deviation of the sum of squares: its residual variance, times the samples per window
-    # (the errors within a window are correlated: the windows count as the independent samples)
-    level = float(sol.fun @ sol.fun) / max(1, n - len(names)) * n / max(1, pr.n_windows)
     try:
         # in the scaled parameters (each about 1): in physical units the columns span ten decades (a
         # contact stiffness of 1e5 N/m beside a play of 1e-3 m) and pinv dropped the stiffest as noise
-        cov = np.linalg.pinv(sol.jac.T @ sol.jac) * level
+        cov, level = block_covariance(pr, fitted, sol.jac, sol.fun, len(anchored))
     except np.linalg.LinAlgError:
         return fitted, Errors(names, np.full((len(names), len(names)), np.nan))
     se = np.sqrt(np.maximum(np.diag(cov), 0.0))
@@ -230,6 +238,31 @@ def fit_model(pr: Problem, model: Model, max_nfev: int = MAX_NFEV, only=None, pr
     cov = cov * np.outer(widen, widen) * np.outer(scale, scale)
     return fitted, Errors(names, cov, {nm: r for nm, r in zip(names, reach) if r}, [names[i] for i in rough],
                           [names[i] for i in flat])
+
+
+def block_covariance(pr: Problem, model: Model, jac: np.ndarray, fun: np.ndarray, n_prior: int
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """Covariance of the fitted parameters (scaled, as ``jac``'s columns) and each one's level: the rise
+    of the sum of squares that one standard error costs along it alone.
+
+    The errors within a window are correlated (the windows count as the independent samples): each
+    block's rows (:attr:`Problem.blocks`: the cart's few long windows, the angle's many short ones) carry
+    its own level, its sum of squares per window, in the sandwich B^-1 (sum_b level_b J_b' J_b) B^-1
+    (B = J'J, the prior's rows with the data's level per window); one block alone gives level B^-1."""
+    rows = [len(shooting.reading_errors(p, pr.rec, key)) for (key, _, _), p in zip(pr.blocks, pr.predictions(model))]
+    data = len(fun) - n_prior
+    bread = np.linalg.pinv(jac.T @ jac)
+    meat = np.zeros_like(bread)
+    o = 0
+    for (_, win, wt), nb in zip(pr.blocks, rows):
+        r, j = fun[o:o + nb], jac[o:o + nb]
+        meat += float(r @ r) / max(1, len(win)) * (j.T @ j)
+        o += nb
+    level_all = float(fun[:data] @ fun[:data]) / max(1, pr.n_windows)
+    meat += level_all * (jac[data:].T @ jac[data:])
+    cov = bread @ meat @ bread
+    d = np.diag(bread)
+    return cov, np.where(d > 0, np.diag(cov) / np.where(d > 0, d, 1.0), level_all)
 
 
 class Errors(dict):
@@ -335,9 +368,7 @@ def drive_crossings(pr: Problem, model: Model) -> np.ndarray:
 def contradictions(pr: Problem, model: Model, name: str) -> list[str]:
     """Why the data refute the fitted effect ``name`` (empty when nothing does)."""
     rec = pr.rec
-    own = set(EFFECTS[name].params)
-    why = [f'{p.name} = {p.value:.4g} {p.unit} ends on its bound [{p.lo:g}, {p.hi:g}]'
-           for p in model.params if p.free and p.name in own and p.at_bound(1e-3 * PARAMS[p.name].typical)]
+    why: list[str] = []
     if name == 'deadzone':
         low = smallest_moving_command(rec)
         if low is not None and model['deadzone_V'] >= low:
@@ -416,9 +447,13 @@ def effect_starts(pr: Problem, model: Model, name: str, prior: Model) -> list[di
         return drive_starts(pr, model, prior)
     if name == 'sensor_bias':
         return [{'bias_theta_rad': float(np.mean(rec.theta)) if rec.theta is not None else 0.0}]
+    if name == 'lag':
+        return [{'input_lag_s': tau} for tau in (0.003, 0.01, 0.03)]
     return [{}]
 
 
+#: the lightest motor side of a drive with play the ladder fits [share of the cart's mass]
+MIN_DRIVE_SHARE = 0.02
 #: the grid :func:`drive_starts` evaluates: plays [m], motor-side masses [share of M], contact
 #: frequencies [Hz] (the contact's stiffness k = m_r (2 pi f)^2, m_r the reduced mass), and the
 #: contact's damping ratio
@@ -431,7 +466,7 @@ def drive_starts(pr: Problem, model: Model, prior: Model, keep: int = 2) -> list
     with the friction of the declared model ``prior`` (a refit without the play distorts it: the
     Coulomb level sinks where the cart coasts through the play)."""
     gaps, shares, freqs, zeta = DRIVE_GRID
-    law = {p.name: p.value for p in prior.free}
+    law = {n: prior[n] for n in LAW_PARAMS[prior.law]}
     model = model.with_values(law)
     grid = []
     for share in shares:
@@ -445,30 +480,107 @@ def drive_starts(pr: Problem, model: Model, prior: Model, keep: int = 2) -> list
     return [grid[i] for i in np.argsort(costs)[:keep]]
 
 
-def short_fit(pe: Problem, current: Model, name: str, prior: Model, ps: Problem | None = None
-              ) -> tuple[Model, float]:
-    """The best short fit of ``current`` + ``name`` over its starts: the effect's own parameters with
-    the friction levels (an effect the refit absorbed into them, a deadzone into the Coulomb level,
-    needs them free to show), SCREEN_NFEV steps from each start, on the cart's windows of ``ps``
-    (:meth:`Problem.screen`, default ``pe``; the angle's too for an effect on the angle). Returns it
-    and the share by which it lowers the estimation error of every window of ``pe`` (0 for a grid
-    point that explains nothing: not fitted). Where the subset's fit does not carry over to every
-    window (it lowers the error by REDO_GAIN on the subset, by less than SCREEN_GAIN on all), the
-    fits are done again on ``pe``; on the subset, the gain is counted from the friction levels
-    refitted there alone (:meth:`Problem.baseline`), not from ``current``."""
-    ps = ps or pe
-    own = set(EFFECTS[name].params)
-    levels = {p.name for p in current.free} & {'Fc', 'Fs_excess'}
-    screen = (own - {'cogging_period_m'}) | levels
-    starts = [current.with_effect(name, s).with_values(s) for s in effect_starts(ps, current, name, prior)]
-    if name in GRID_SCREENED:
+@dataclass
+class Hypothesis:
+    """One explanation of what the current model misses: a model with some parameters to fit.
+
+    kind : 'friction' (the declared law refitted), 'law' (another friction law), 'plant' (a declared
+        constant corrected: the effective mass with the rotor reflected, the motor's alpha or beta) or
+        'effect' (one of the library's, with the friction levels refitted beside it or, on the declared
+        friction, alone)
+    own : the parameters that are the hypothesis (checked: bounds, size, relevance)
+    free : the parameters its short fit moves (own, and the friction levels where they may move)
+    """
+
+    label: str
+    kind: str
+    model: Model
+    own: tuple
+    free: tuple
+    starts: list = field(default_factory=lambda: [{}])
+    effect: str | None = None
+
+
+def law_starts(declared: Model) -> dict:
+    """Start values of every friction parameter a law switch may need: the declared model's, else the
+    typical sizes."""
+    return {n: declared.get(n, PARAMS[n].typical) for n in FRICTION_FITTED}
+
+
+#: presliding displacements [m] the bristle starts of the dynamic law are taken at (sigma0 = Fs / z)
+BRISTLE_Z = (1e-4, 1e-5)
+
+
+def bristle_starts(model: Model) -> list[dict]:
+    """Start values of the dynamic law's bristles: a stiffness that holds the static level within each
+    presliding displacement of BRISTLE_Z, damped critically on the cart's mass (sigma1 = 2 sqrt(sigma0 M))."""
+    fs = model['Fc'] + model['Fs_excess']
+    p = model.param('sigma0')
+    out = []
+    for z in BRISTLE_Z:
+        s0 = min(max(fs / z, p.lo), 0.5 * p.hi)
+        out.append({'sigma0': s0, 'sigma1': min(2 * math.sqrt(s0 * model['M']), PARAMS['sigma1'].hi)})
+    return out
+
+
+def hypotheses(pe: Problem, current: Model, declared: Model, allowed=None) -> list[Hypothesis]:
+    """The explanations a round tries against ``current`` (see :class:`Hypothesis`): the declared law
+    refitted (until it is), each other law, each plant correction not made yet, each library effect not
+    added (``allowed`` restricts them), with the friction levels refitted and, before any refit, also
+    on the declared friction alone."""
+    rec = pe.rec
+    law = LAW_PARAMS[current.law]
+    levels = tuple(n for n in ('Fc', 'Fs_excess') if n in law)
+    out = []
+    if not current.fitted(law):
+        out.append(Hypothesis('refit', 'friction', current.with_free(law), law, law))
+    for other in LAWS:
+        if other != current.law:
+            m = current.with_law(other, law_starts(declared))
+            if other == 'dynamic':      # bristles stiffer than a tenth of a count of presliding are not seen
+                m = m.with_bounds('sigma0', 0.0, 10 * (m['Fc'] + m['Fs_excess']) / rec.x_resolution)
+            out.append(Hypothesis(f'law {other}', 'law', m, LAW_PARAMS[other], LAW_PARAMS[other],
+                                  bristle_starts(m) if other == 'dynamic' else [{}]))
+    for name in PLANT_CORRECTIONS:
+        if not current.param(name).free and not (name == 'beta' and current[name] == 0.0):
+            out.append(Hypothesis(f'{name} corrected', 'plant', current.with_free((name,) + law), (name,),
+                                  (name,) + levels))
+    refitted = current.fitted(law)
+    for name in LADDER_EFFECTS:
+        if name in current.effects or (allowed is not None and name not in allowed):
+            continue
+        if EFFECTS[name].needs_theta and rec.theta is None:
+            continue
+        own = EFFECTS[name].params
+        starts = effect_starts(pe, current, name, declared)
+        base = current.with_effect(name)
+        if name == 'drive_backlash':   # a motor side lighter than this is no drive (and its contact rings at kHz)
+            base = base.with_bounds('drive_mass_kg', MIN_DRIVE_SHARE * current['M'], math.inf)
+        out.append(Hypothesis(name, 'effect', base.with_free(levels), own, own + levels, starts, name))
+        if not refitted:
+            out.append(Hypothesis(f'{name} on the declared friction', 'effect', base, own, own, starts, name))
+    return out
+
+
+def short_fit(pe: Problem, current: Model, h: Hypothesis, prior: Model, ps: Problem) -> tuple[Model, float]:
+    """The best short fit of hypothesis ``h`` over its starts (SCREEN_NFEV steps each, its ``free``
+    parameters) on the cart's windows of ``ps`` (:meth:`Problem.screen`; the angle's too for an effect on
+    the angle), and the share by which it lowers the estimation error of every window of ``pe`` (0 for a
+    drive play whose best grid point explains nothing: not fitted). Where the subset's fit does not
+    carry over to every window (it gains REDO_GAIN on the subset, less than SCREEN_GAIN on all), the
+    fits are done again on ``pe``; on the subset, the gain is counted from the friction levels refitted
+    there alone (:meth:`Problem.baseline`), not from ``current``."""
+    starts = [h.model.with_values(s) for s in h.starts]
+    if h.effect in GRID_SCREENED:
         costs = [ps.cart_cost(m) for m in starts]
         if min(costs) > (1 - SCREEN_GAIN) * ps.cart_cost(current):
             return starts[int(np.argmin(costs))], 0.0   # the best of a grid explains nothing: not fitted
+    levels = set(h.free) - set(h.own)
+    on_angle = h.effect is not None and EFFECTS[h.effect].needs_theta
 
     def fit(pr):
-        pr = pr if EFFECTS[name].needs_theta else pr.cart()
-        fits = [fit_model(pr, m, max_nfev=SCREEN_NFEV, only=screen, prior=prior, errors=False)[0]
+        pr = pr if on_angle else pr.cart()
+        fits = [fit_model(pr, m, max_nfev=SCREEN_NFEV, only=set(h.free), prior=prior, errors=False)[0]
                 for m in starts]
         best = fits[int(np.argmin([pr.cost(m) for m in fits]))]
         return best, 1.0 - pr.cost(best) / pr.cost(pr.baseline(current, levels, prior))
@@ -480,20 +592,146 @@ def short_fit(pe: Problem, current: Model, name: str, prior: Model, ps: Problem 
     return best, full
 
 
-def full_fit(pe: Problem, current: Model, best: Model, name: str, prior: Model) -> tuple[Model, dict]:
-    """The fit of the effect's own parameters with the friction law's levels and slope from the short
-    fit ``best``, with standard errors."""
-    own = set(EFFECTS[name].params)
-    joint = own | ({p.name for p in current.free} & {'Fc', 'Fs_excess', 'eps'})
-    return fit_model(pe, best, only=joint, prior=prior, profile=SIZE.get(name, ()))
+def joint(h: Hypothesis, model: Model) -> set:
+    """The parameters a hypothesis's full fit moves: its own and those the model already fits (its
+    friction law's among them)."""
+    return set(h.free) | {p.name for p in model.free}
 
 
-def candidate(pe: Problem, current: Model, name: str, prior: Model, ps: Problem | None = None
-              ) -> tuple[Model, dict]:
-    """:func:`short_fit`, then :func:`full_fit` when it lowers the estimation error by SCREEN_GAIN at least
-    (else the short fit, without standard errors: :func:`unresolved` refuses it)."""
-    best, gain = short_fit(pe, current, name, prior, ps)
-    return full_fit(pe, current, best, name, prior) if gain >= SCREEN_GAIN else (best, {})
+def full_fit(pe: Problem, h: Hypothesis, best: Model, prior: Model) -> Model:
+    """The fit of the hypothesis's parameters with every parameter the model already fits (:func:`joint`),
+    from its short fit ``best``."""
+    return fit_model(pe, best, only=joint(h, best), prior=prior, errors=False)[0]
+
+
+def errors_of(pe: Problem, h: Hypothesis, model: Model, prior: Model) -> dict:
+    """The standard errors of a fitted hypothesis's parameters at its fit (no step taken: the Jacobian
+    there, checked along each parameter of its own; :func:`fit_model`)."""
+    return fit_model(pe, model, max_nfev=0, only=joint(h, model), prior=prior,
+                     profile=set(SIZE.get(h.effect or '', ())) | set(h.own))[1]
+
+
+def on_bounds(model: Model) -> list[str]:
+    """Why a fitted parameter of ``model`` refutes it: it ends on a bound of its range (a bound reached
+    means the law or the effect is refuted there)."""
+    return [f'{p.name} = {p.value:.4g} {p.unit} ends on its bound [{p.lo:g}, {p.hi:g}]'
+            for p in model.free if p.at_bound(1e-3 * PARAMS[p.name].typical)]
+
+
+def untold(model: Model, std: dict) -> list[str]:
+    """A friction level that is not told from zero refutes the model: a real cart slides against a
+    Coulomb level (Fc within two standard errors of 0 means the model makes up for something else)."""
+    s = std.get('Fc')
+    if 'Fc' in {p.name for p in model.free} and s is not None and math.isfinite(s) and model['Fc'] <= 2 * s:
+        return [f'Fc = {model["Fc"]:.3g} +/- {s:.2g} N is not told from zero: a real cart slides against a '
+                f'Coulomb level; the model makes up for something else']
+    return []
+
+
+def contribution(pv: Problem, model: Model, without: Model) -> float:
+    """RMS difference [counts] of the cart's predicted readings of ``model`` and ``without`` over the
+    validation windows: what the hypothesis does to the simulated motion."""
+    key, win, _ = pv.blocks[0]
+    a, b = pv.predictions(model)[0], shooting.predict(without.vectors(), pv.rec, win)
+    c = a.compared & np.isfinite(a.x) & np.isfinite(b.x)
+    d = (a.x[c] - b.x[c]) / pv.rec.x_resolution
+    return float(np.sqrt(np.mean(d ** 2))) if len(d) else 0.0
+
+
+@dataclass
+class Judged:
+    """A hypothesis fitted and judged on the validation data."""
+
+    h: Hypothesis
+    model: Model
+    std: dict
+    gain: float            # validation error drop [%]
+    p_value: float
+    score: float           # validation cost with the per-parameter penalty (lower is better)
+    refused: list
+
+
+def judge(pe: Problem, pv: Problem, current: Model, h: Hypothesis, m: Model, note: str | None, sse0_v) -> Judged:
+    """The checks of a fitted hypothesis that need no standard errors (module docstring); its score is
+    the validation mean squared error times exp(2 k / n), k its fitted parameters and n the validation
+    windows (the per-parameter penalty of an information criterion with the windows as the independent
+    samples). ``note``: why it was not fitted in full (then it is refused)."""
+    ev0, ev1 = pv.cost(current), pv.cost(m)
+    ee0, ee1 = pe.cost(current), pe.cost(m)
+    gain = 100 * (1 - math.sqrt(ev1 / ev0)) if ev0 > 0 else 0.0
+    pval = block_p_value(sse0_v, pv.window_sse(m))
+    why = ([note] if note else []) + on_bounds(m)
+    if h.effect and not (note or '').startswith('its short fit: '):
+        why += contradictions(pe, m, h.effect)
+    drop = math.sqrt(ev0) - math.sqrt(ev1)
+    if gain <= SIM_GAIN_PERCENT:
+        why.append(f'validation error drops by {gain:.2f} % (needs > {SIM_GAIN_PERCENT:g} %)')
+    elif drop < MIN_DROP_COUNTS:
+        why.append(f'validation error drops by {drop:.3g} count (needs {MIN_DROP_COUNTS:g}: below that '
+                   f'it is the encoders\' rounding)')
+    elif pval >= P_VALUE:
+        why.append(f'the drop is not significant (p = {pval:.2g} over {pv.n_windows} windows)')
+    if ee1 >= ee0:
+        why.append('the estimation error does not drop')
+    before, after = pv.summary(current), pv.summary(m)
+    for key in ('x_rms_counts', 'theta_rms_counts'):
+        if key in before and after[key] > before[key] * (1 + WORSE_PERCENT / 100):
+            why.append(f'validation {key.split("_")[0]} error rises from {before[key]:.3g} to {after[key]:.3g} counts')
+    k = len(m.free)
+    return Judged(h, m, {}, gain, pval, ev1 * math.exp(2 * k / max(pv.n_windows, 1)), why)
+
+
+def confirm(pe: Problem, pv: Problem, current: Model, j: Judged, prior: Model) -> None:
+    """The checks of a hypothesis that passed :func:`judge` which need its standard errors (its size told
+    from zero, a Coulomb level told from zero) and its contribution to the simulated motion; the reasons
+    it fails them are added to ``j.refused``."""
+    j.std = errors_of(pe, j.h, j.model, prior)
+    why = untold(j.model, j.std) + (unresolved(j.model, j.std, j.h.effect) if j.h.effect else [])
+    if not why:
+        size = contribution(pv, j.model, j.model.without(j.h.effect) if j.h.effect else current)
+        if size < CONTRIBUTION_COUNTS:
+            why.append(f'it changes the simulated motion by {size:.2g} counts RMS (needs {CONTRIBUTION_COUNTS:g}: '
+                       f'too small to matter at the encoders)')
+    j.refused += why
+
+
+def screen(hs: list[Hypothesis], short: list[tuple[Model, float]], pe: Problem, current: Model
+           ) -> list[str | None]:
+    """Which hypotheses are fitted in full this round: per hypothesis None, or why not. An effect with the
+    friction levels free is measured by what it adds to the refit's short fit (the refit's gain it takes
+    for free); the others by their gain over ``current``. A short fit the data already contradict
+    (:func:`contradictions`) is refused here and takes no place in its group. A hypothesis is fitted in
+    full when its gain reaches SCREEN_GAIN and FULL_SHARE of the best of its group's, and it is among the
+    FULL_TOP best of it."""
+    refit = next((m for h, (m, _) in zip(hs, short) if h.label == 'refit'), None)
+    base = pe.cost(refit) if refit is not None else None
+    gains = []
+    refuted = []
+    for h, (m, g) in zip(hs, short):
+        levels = bool(set(h.free) - set(h.own)) and h.kind == 'effect'
+        gains.append((levels, 1.0 - pe.cost(m) / base if levels and base else g))
+        why = contradictions(pe, m, h.effect) if h.effect and g >= SCREEN_GAIN else []
+        refuted.append('its short fit: ' + '; '.join(why) if why else None)
+    alive = [(lv, g) for (lv, g), r in zip(gains, refuted) if r is None]
+    top = {grp: max([g for lv, g in alive if lv == grp], default=0.0) for grp in (True, False)}
+    rank = {grp: sorted((g for lv, g in alive if lv == grp), reverse=True) for grp in (True, False)}
+    out: list[str | None] = []
+    for (lv, g), r in zip(gains, refuted):
+        what = 'beyond the refit\'s' if lv else 'over the model\'s'
+        if r is not None:
+            out.append(r)
+        elif g < SCREEN_GAIN:
+            out.append(f'its short fit lowers the estimation error by {100 * g:.2g} % {what} only')
+        elif g < FULL_SHARE * top[lv]:
+            out.append(f'its short fit lowers the estimation error by {100 * g:.2g} % {what}, less than '
+                       f'{100 * FULL_SHARE:g} % of the best one\'s {100 * top[lv]:.2g} %: not fitted in full '
+                       f'this round')
+        elif rank[lv].index(g) >= FULL_TOP:
+            out.append(f'its short fit lowers the estimation error by {100 * g:.2g} % {what}: not among the '
+                       f'{FULL_TOP} best of its group, not fitted in full this round')
+        else:
+            out.append(None)
+    return out
 
 
 @dataclass
@@ -506,75 +744,138 @@ class Step:
     notes: list
 
 
+def correction_notes(declared: Model, model: Model, std: dict) -> list[str]:
+    """A corrected plant constant, as the data say it: 'the declared M is 0.38 kg, the data say 0.52 +/-
+    0.01 kg'."""
+    out = []
+    for name in PLANT_CORRECTIONS:
+        p = model.param(name)
+        if p.free:
+            s = std.get(name)
+            err = f' +/- {s:.2g}' if s is not None and math.isfinite(s) else ''
+            out.append(f'the declared {name} is {declared[name]:.4g} {p.unit}, the data say {p.value:.4g}{err} '
+                       f'{p.unit}')
+    return out
+
+
+def verdict(pv: Problem, model: Model) -> dict:
+    """Whether the final model explains the validation data: its simulation error against what the
+    encoders' rounding alone would leave (:func:`shooting.quantization_floor`), on the cart and (with a
+    pendulum) the angle. Explained when each is within EXPLAINED_FACTOR of its floor plus
+    EXPLAINED_SLACK counts."""
+    summ = pv.summary(model)
+    out: dict = {}
+    ok = True
+    for key, win, _ in pv.blocks:
+        fl = shooting.quantization_floor(model.vectors(), pv.rec, win, key)
+        out[key] = {'counts': summ[f'{key}_rms_counts'], 'percent': summ[f'{key}_percent'],
+                    'floor_counts': fl[f'{key}_floor_counts'], 'floor_percent': fl[f'{key}_floor_percent']}
+        ok &= out[key]['counts'] <= EXPLAINED_FACTOR * out[key]['floor_counts'] + EXPLAINED_SLACK
+    x = out['x']
+    if ok:
+        reason = (f'explained: {x["percent"]:.3g} % of the motion is left, what the encoders\' rounding alone leaves '
+                  f'({x["floor_percent"]:.3g} %)')
+    else:
+        worst = max(out, key=lambda k: out[k]['counts'] / max(out[k]['floor_counts'], 1e-9))
+        w = out[worst]
+        reason = (f'not explained: {x["percent"]:.3g} % of the motion is left ({x["counts"]:.3g} counts RMS), where '
+                  f'the encoders\' rounding alone would leave {x["floor_percent"]:.3g} % ({x["floor_counts"]:.3g} '
+                  f'counts)' + ('' if worst == 'x' else f'; the angle: {w["percent"]:.3g} % left, '
+                                                        f'{w["floor_percent"]:.3g} % from rounding'))
+    return {'explained': bool(ok), 'unexplained_percent': x['percent'], 'floor_percent': x['floor_percent'],
+            'unexplained_counts': x['counts'], 'floor_counts': x['floor_counts'], 'reason': reason,
+            'blocks': out}
+
+
 def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress=None) -> dict:
-    """The ladder on ``est`` (fits) and ``val`` (judgement); see the module docstring."""
+    """The ladder on ``est`` (fits) and ``val`` (judgement): the declared model, then round by round the
+    explanation that wins on validation among the competing hypotheses (:func:`hypotheses`), until the
+    data are explained down to the encoders' floor or nothing passes; see the module docstring."""
     say = progress or (lambda msg: None)
     pe, pv = Problem(est), Problem(val)
+    current = declared
     steps = [Step('declared', declared, {}, pe.summary(declared), pv.summary(declared), [])]
     say(f'declared model: validation x error {steps[0].val["x_rms_counts"]:.3g} counts')
-    refit, std = fit_model(pe, declared, max_nfev=60, prior=declared)
-    notes = []
-    for p in refit.free:
-        old = declared.param(p.name).value
-        if abs(p.value - old) > REFIT_NOTE * max(abs(old), PARAMS[p.name].typical):
-            notes.append(f'{p.name} refitted from {old:.4g} to {p.value:.4g} {p.unit} '
-                         f'({100 * (p.value - old) / (abs(old) or 1):+.0f} %): the declared model misses something')
-        if p.at_bound(1e-3 * PARAMS[p.name].typical):
-            notes.append(f'{p.name} = {p.value:.4g} {p.unit} ends on its bound [{p.lo:g}, {p.hi:g}]: the data '
-                         f'contradict the declared law there')
-    steps.append(Step('refit', refit, std, pe.summary(refit), pv.summary(refit), notes))
-    say(f'refit: validation x error {steps[-1].val["x_rms_counts"]:.3g} counts')
-    current, tried = refit, []
+    if declared.free:        # constants the user asked to fit (--free): fitted with the law first, whatever the verdict
+        law = LAW_PARAMS[declared.law]
+        current, s = fit_model(pe, declared.with_free(law), prior=declared)
+        steps.append(Step('refit', current, s, pe.summary(current), pv.summary(current),
+                          correction_notes(declared, current, s) + refit_notes(declared, current)))
+        say(f'refit with {", ".join(p.name for p in declared.free)}: validation x error '
+            f'{steps[-1].val["x_rms_counts"]:.3g} counts')
+    tried: list[dict] = []
+    rounds: list[dict] = []
     ps = pe.screen()
-    for _ in range(MAX_ROUNDS):
-        sse0_v = pv.window_sse(current)
-        ranked = []
-        names = [name for name in LADDER_EFFECTS if name not in current.effects
-                 and (allowed is None or name in allowed) and not (EFFECTS[name].needs_theta and est.theta is None)]
-        short = {name: short_fit(pe, current, name, declared, ps) for name in names}
-        top = max([gain for _, gain in short.values()], default=0.0)
-        for name in names:
-            m, screened = short[name]
-            s: dict = {}
-            behind = SCREEN_GAIN <= screened < FULL_SHARE * top
-            if screened >= SCREEN_GAIN and not behind:
-                m, s = full_fit(pe, current, m, name, declared)
-            ev0, ev1 = pv.cost(current), pv.cost(m)
-            ee0, ee1 = pe.cost(current), pe.cost(m)
-            gain = 100 * (1 - math.sqrt(ev1 / ev0)) if ev0 > 0 else 0.0
-            pval = block_p_value(sse0_v, pv.window_sse(m))
-            why = contradictions(pe, m, name)
-            if behind:
-                why.append(f'its short fit lowers the estimation error by {100 * screened:.2g} %, less than '
-                           f'{100 * FULL_SHARE:g} % of the best one\'s {100 * top:.2g} %: not fitted in full '
-                           f'this round')
-            else:
-                why += unresolved(m, s, name)
-            drop = math.sqrt(ev0) - math.sqrt(ev1)
-            if gain <= SIM_GAIN_PERCENT:
-                why.append(f'validation error drops by {gain:.2f} % (needs > {SIM_GAIN_PERCENT:g} %)')
-            elif drop < MIN_DROP_COUNTS:
-                why.append(f'validation error drops by {drop:.3g} count (needs {MIN_DROP_COUNTS:g}: below that '
-                           f'it is the encoders\' rounding)')
-            elif pval >= P_VALUE:
-                why.append(f'the drop is not significant (p = {pval:.2g} over {pv.n_windows} windows)')
-            if ee1 >= ee0:
-                why.append('the estimation error does not drop')
-            before, after = pv.summary(current), pv.summary(m)
-            for key in ('x_rms_counts', 'theta_rms_counts'):
-                if key in before and after[key] > before[key] * (1 + WORSE_PERCENT / 100):
-                    why.append(f'validation {key.split("_")[0]} error rises from {before[key]:.3g} to '
-                               f'{after[key]:.3g} counts')
-            tried.append({'effect': name, 'validation_gain_percent': gain, 'p_value': pval,
-                          'values': {n: m[n] for n in EFFECTS[name].params}, 'refused': why, 'kept': False})
-            say(f'  tried {name:<11} gain {gain:6.2f} %  p {pval:.2g}  ' + ('; '.join(why) or 'passes'))
-            ranked.append((gain, name, m, s, why, len(tried) - 1))
-        ok = [r for r in ranked if not r[4]]
-        if not ok:
+    for round_no in range(1, MAX_ROUNDS + 1):
+        if verdict(pv, current)['explained']:
             break
-        gain, name, m, s, _, i = max(ok, key=lambda r: r[0])
-        tried[i]['kept'] = True
-        current, s = fit_model(pe, m, max_nfev=60, prior=declared)   # every free parameter together
-        steps.append(Step(f'+ {name}', current, s, pe.summary(current), pv.summary(current), []))
-        say(f'kept {name}: validation x error {steps[-1].val["x_rms_counts"]:.3g} counts')
-    return {'steps': steps, 'tried': tried, 'estimation': est, 'validation': val}
+        sse0_v = pv.window_sse(current)
+        hs = hypotheses(pe, current, declared, allowed)
+        short = [short_fit(pe, current, h, declared, ps) for h in hs]
+        notes = screen(hs, short, pe, current)
+        judged = []
+        for h, (m, _), note in zip(hs, short, notes):
+            judged.append(judge(pe, pv, current, h, full_fit(pe, h, m, declared) if note is None else m, note, sse0_v))
+        passing = sorted((j for j in judged if not j.refused), key=lambda j: j.score)
+        ok = []
+        for j in passing:            # the standard errors of the best ones, until two pass
+            confirm(pe, pv, current, j, declared)
+            if not j.refused:
+                ok.append(j)
+                if len(ok) == 2:
+                    break
+        for j in judged:
+            tried.append({'round': round_no, 'hypothesis': j.h.label, 'kind': j.h.kind,
+                          'effect': j.h.effect or j.h.label, 'validation_gain_percent': j.gain,
+                          'p_value': j.p_value, 'validation_x_rms_counts': pv.summary(j.model)['x_rms_counts'],
+                          'values': {n: j.model[n] for n in j.h.own}, 'refused': j.refused,
+                          'kept': bool(ok) and j is ok[0]})
+            say(f'  tried {j.h.label:<30} gain {j.gain:6.2f} %  p {j.p_value:.2g}  '
+                + ('; '.join(j.refused) or ('kept' if ok and j is ok[0] else 'passes')))
+        others = sorted((j for j in judged if not ok or j is not ok[0]),
+                        key=lambda j: (bool(j.refused), j.score if not j.refused else -j.gain))
+        runner = others[0] if others else None
+        if not ok:
+            rounds.append({'round': round_no, 'kept': None,
+                           'runner_up': _alternative(runner, pv) if runner else None})
+            break
+        win = ok[0]
+        current, s = fit_model(pe, win.model, max_nfev=60, prior=declared)   # every fitted parameter together
+        if on_bounds(current) or untold(current, s) or pv.cost(current) > pv.cost(win.model):
+            current, s = win.model, win.std
+        label = {'friction': 'refit', 'law': win.h.label, 'plant': win.h.label}.get(win.h.kind, f'+ {win.h.effect}')
+        step_notes = correction_notes(declared, current, s) if win.h.kind == 'plant' else []
+        step_notes += refit_notes(declared, current) if win.h.kind in ('friction', 'law', 'plant') else []
+        steps.append(Step(label, current, s, pe.summary(current), pv.summary(current), step_notes))
+        rounds.append({'round': round_no, 'kept': win.h.label,
+                       'runner_up': _alternative(runner, pv) if runner else None})
+        say(f'kept {win.h.label}: validation x error {steps[-1].val["x_rms_counts"]:.3g} counts'
+            + (f'; runner-up {runner.h.label} ({pv.summary(runner.model)["x_rms_counts"]:.3g} counts)'
+               if runner else ''))
+    v = verdict(pv, current)
+    if not v['explained']:
+        last = rounds[-1]['round']
+        left = sorted((t for t in tried if t['round'] == last), key=lambda t: -t['validation_gain_percent'])
+        v['tried'] = sorted({t['hypothesis'] for t in tried})
+        v['largest_left'] = [{'hypothesis': t['hypothesis'], 'validation_gain_percent': t['validation_gain_percent'],
+                              'refused': t['refused']} for t in left[:3]]
+    say(v['reason'])
+    return {'steps': steps, 'tried': tried, 'rounds': rounds, 'verdict': v, 'estimation': est, 'validation': val}
+
+
+def _alternative(j: Judged, pv: Problem) -> dict:
+    return {'hypothesis': j.h.label, 'validation_x_rms_counts': pv.summary(j.model)['x_rms_counts'],
+            'validation_gain_percent': j.gain, 'refused': j.refused}
+
+
+def refit_notes(declared: Model, model: Model) -> list[str]:
+    """A declared friction value the refit moved by more than REFIT_NOTE."""
+    out = []
+    for p in model.free:
+        if p.name not in FRICTION_FITTED or not any(q.name == p.name for q in declared.params):
+            continue
+        old = declared[p.name]
+        if abs(p.value - old) > REFIT_NOTE * max(abs(old), PARAMS[p.name].typical):
+            out.append(f'{p.name} refitted from {old:.4g} to {p.value:.4g} {p.unit} '
+                       f'({100 * (p.value - old) / (abs(old) or 1):+.0f} %)')
+    return out

@@ -1,4 +1,4 @@
-"""Report of a ladder identification: result.json, report.md and PNG figures in one directory."""
+"""Report of an identification: result.json, report.md and PNG figures in one directory."""
 from __future__ import annotations
 
 import json
@@ -12,12 +12,12 @@ matplotlib.use('Agg')
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from ..analysis.plots import save_figure  # noqa: E402
 from ..analysis.records import smooth_rate  # noqa: E402
 from ..physics.friction import friction_force  # noqa: E402
 from . import shooting  # noqa: E402
 from .effects import PARAMS  # noqa: E402
 from .ladder import Problem, Step  # noqa: E402
-from .report import save_figure, write_report  # noqa: E402
 
 __all__ = ['correlation_lines', 'write_ladder_report']
 
@@ -166,8 +166,13 @@ def ladder_result(res: dict) -> dict:
                     'friction_at_speeds': friction_curve(s, at), 'notes': s.notes + coverage_note(s, at)}
                    for s in steps],
         'effects_added': list(steps[-1].model.effects),
+        'verdict': res['verdict'],
+        'rounds': res['rounds'],
         'effects_tried': res['tried'],
         'identified': identified(steps[-1], est.dt),
+        **({'force_error': res['force_error']} if 'force_error' in res else {}),
+        **({'test': {k: v for k, v in res['test'].items() if k not in ('t', 'simulated', 'measured')}}
+           if 'test' in res else {}),
     }
 
 
@@ -191,7 +196,20 @@ def ladder_markdown(r: dict) -> str:
         th = f'{v["theta_rms_counts"]:.3g}' if 'theta_rms_counts' in v else '-'
         lines.append(f'| {s["step"]} | {e["x_rms_counts"]:.3g} | {v["x_rms_counts"]:.3g} | {v["x_percent"]:.3g} '
                      f'| {th} |')
-    lines += ['', f'Effects added: {", ".join(r["effects_added"]) or "none"}.', '']
+    v = r['verdict']
+    lines += ['', f'Effects added: {", ".join(r["effects_added"]) or "none"}.', '', f'**Verdict**: {v["reason"]}.', '']
+    if not v['explained']:
+        lines += ['Tried: ' + ', '.join(v.get('tried', [])) + '.', '',
+                  'The largest signatures left (the hypotheses of the last round that lowered the validation '
+                  'error most, and why each was refused):', '']
+        lines += [f'- {t["hypothesis"]}: {t["validation_gain_percent"]:.3g} % ({"; ".join(t["refused"])})'
+                  for t in v.get('largest_left', [])] + ['']
+    lines += ['Rounds (the explanation kept, and the runner-up with its validation error):', '']
+    for rd in r['rounds']:
+        ru = rd['runner_up']
+        lines.append(f'- round {rd["round"]}: kept {rd["kept"] or "nothing"}'
+                     + (f'; runner-up {ru["hypothesis"]} ({ru["validation_x_rms_counts"]:.3g} counts)' if ru else ''))
+    lines.append('')
     for s in r['ladder']:
         lines += [f'### {s["step"]}', '', '| parameter | value | unit | fitted | |', '| --- | --- | --- | --- | --- |']
         for p in s['params']:
@@ -203,12 +221,24 @@ def ladder_markdown(r: dict) -> str:
         units = {p['name']: p['unit'] for p in s['params']}
         notes = s['notes'] + correlation_lines(s, units)
         lines += [''] + [f'- {n}' for n in notes] + ([''] if notes else [])
-    lines += ['## Effects tried', '', '| effect | validation gain % | p | kept | why not |',
-              '| --- | --- | --- | --- | --- |']
+    lines += ['## Hypotheses tried', '', '| round | hypothesis | validation gain % | p | kept | why not |',
+              '| --- | --- | --- | --- | --- | --- |']
     for t in r['effects_tried']:
         why = '; '.join(t['refused']).replace('|', '/')
-        lines.append(f'| {t["effect"]} | {t["validation_gain_percent"]:.2f} | {t["p_value"]:.2g} | {t["kept"]} '
-                     f'| {why} |')
+        lines.append(f'| {t["round"]} | {t["hypothesis"]} | {t["validation_gain_percent"]:.2f} | {t["p_value"]:.2g} '
+                     f'| {t["kept"]} | {why} |')
+    if 'force_error' in r:
+        lines += ['', '## Force error', '', 'Relative force error 100 ||F - F_model|| / ||F|| of each step\'s force '
+                  'balance (filtered, decimated; the EMPS benchmark\'s metric):', '',
+                  '| step | estimation % | validation % |', '| --- | --- | --- |']
+        lines += [f'| {f["step"]} | {f["estimation"]["relative_percent"]:.3f} | '
+                  f'{f["validation"]["relative_percent"]:.3f} |' for f in r['force_error']]
+    if 'test' in r:
+        t = r['test']
+        lines += ['', '## Test record run free', '', f'The final model run free over {t["record"]} from its first '
+                  f'{t["init_samples"]} readings: position RMS error {t["rmse_mm"]:.4g} mm '
+                  f'({t["rmse_counts"]:.4g} counts) over {t["samples"]} readings, a travel of '
+                  f'{t["travel_mm"]:.4g} mm (figure test.png).']
     idf = r['identified']
     lines += ['', '## Identified model (scenario sections)', '', '```yaml',
               f'plant: {json.dumps(idf["plant"])}', f'friction: {json.dumps(idf["friction"])}',
@@ -249,9 +279,27 @@ def ladder_figures(res: dict, out: Path) -> list[str]:
     axes[-1, 0].set_xlabel('time (s)')
     fig.suptitle('validation windows: measured and simulated cart position')
     files.append(save_figure(fig, out / 'windows.png'))
-    return files
+    if 'test' in res:
+        t = res['test']
+        fig, ax = plt.subplots(2, 1, figsize=(9, 5), sharex=True)
+        ax[0].plot(t['t'], t['measured'] * 1e3, 'k', lw=1, label='measured')
+        ax[0].plot(t['t'], t['simulated'] * 1e3, lw=1, label=f'{steps[-1].label}, run free')
+        ax[0].set(ylabel='x (mm)', title=f'{t["record"]}: the final model run free from {t["init_samples"]} readings')
+        ax[0].legend(fontsize=7)
+        ax[1].plot(t['t'], (t['simulated'] - t['measured']) * 1e3, lw=0.8)
+        ax[1].set(xlabel='time (s)', ylabel='error (mm)')
+        files.append(save_figure(fig, out / 'test.png'))
+    return [str(f) for f in files]
 
 
 def write_ladder_report(res: dict, out: str | Path, plots: bool = True) -> dict:
-    """Write result.json, report.md and the figures of a ladder into ``out``; the result dict."""
-    return write_report(res, out, plots, ladder_result, ladder_figures, ladder_markdown)
+    """Write result.json, report.md and the figures of a ladder (:func:`ladder.run_ladder`'s result) into
+    ``out``; the result dict (result.json's content)."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    r = ladder_result(res)
+    r['figures'] = ladder_figures(res, out) if plots else []
+    r['files'] = {'report': str(out / 'report.md'), 'result': str(out / 'result.json')}
+    (out / 'result.json').write_text(json.dumps(r, indent=2, default=float))
+    (out / 'report.md').write_text(ladder_markdown(r))
+    return r

@@ -131,11 +131,12 @@ def rough(difference, x, r0, step, cols):
     return np.where(den > 0, num / np.where(den > 0, den, 1.0), 1.0)
 
 
-def quadratic(objective, x, lo, hi, se, level: float, at: float, cols):
+def quadratic(objective, x, lo, hi, se, level, at: float, cols):
     """The parameters of ``cols`` along which the sum of squares ``objective`` (``at`` at ``x``) does not
     rise by QUADRATIC_RISE levels at PROBE_SIGMAS standard errors ``se`` each way, the others fixed (a
     quadratic sum of squares rises by PROBE_SIGMAS^2 levels there, more where parameters are
-    correlated): there the Jacobian's error is too small (a profile with a long flat side)."""
+    correlated): there the Jacobian's error is too small (a profile with a long flat side). ``level``: the
+    rise one standard error costs, per parameter."""
     out = []
     for i in cols:
         if not (np.isfinite(se[i]) and se[i] > 0):
@@ -146,13 +147,13 @@ def quadratic(objective, x, lo, hi, se, level: float, at: float, cols):
                 continue
             xi = x.copy()
             xi[i] += sign * d
-            if objective(xi) - at < QUADRATIC_RISE * level:
+            if objective(xi) - at < QUADRATIC_RISE * level[i]:
                 out.append(i)
                 break
     return out
 
 
-def scan_errors(objective, x, lo, hi, se, level: float, at: float, which):
+def scan_errors(objective, x, lo, hi, se, level, at: float, which):
     """Errors of the parameters ``which`` from the sum of squares ``objective`` along each alone (the
     Jacobian's errors ``se`` mean nothing where the error is rough: it measures how much the
     prediction changes, not whether it gets worse). Each side is probed at distances doubling from
@@ -162,7 +163,8 @@ def scan_errors(objective, x, lo, hi, se, level: float, at: float, which):
     the farthest probe where the sum of squares (``at`` at ``x``) rose by less than SCAN_SIGMAS^2
     levels (or SCAN_SIGMAS jitters), no less than ``se``; a side ends after two probes above
     SCAN_STOP levels (and three jitters). Returns the errors and, per parameter, '' or the bound(s)
-    that a low probe reached ('lo', 'hi', 'both')."""
+    that a low probe reached ('lo', 'hi', 'both'). ``level``: the rise one standard error costs, per
+    parameter."""
     out, reach = np.array(se, float), [''] * len(x)
     for i in which:
         sides: list = []
@@ -177,7 +179,7 @@ def scan_errors(objective, x, lo, hi, se, level: float, at: float, which):
         def probe(sign, step, i=i):
             xi = x.copy()
             xi[i] += sign * step
-            return (objective(xi) - at) / level
+            return (objective(xi) - at) / level[i]
         for sign, steps, _, rises in sides:
             rises += [probe(sign, d) for d in steps[:2]]
         # the jitter: what a rise growing with the squared distance does not explain at the near probes

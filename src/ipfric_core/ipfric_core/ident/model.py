@@ -45,14 +45,15 @@ class Param:
 PLANT_KNOWN = ('M', 'm', 'l', 'alpha', 'beta')
 #: the friction parameters each declared law fits (levels in N: the same for any normal force)
 LAW_PARAMS = {'viscous': ('eps',), 'coulomb': ('Fc', 'Fs_excess', 'eps'),
-              'exponential': ('Fc', 'Fs_excess', 'eps', 'v_s')}
+              'exponential': ('Fc', 'Fs_excess', 'eps', 'v_s'),
+              'dynamic': ('Fc', 'Fs_excess', 'eps', 'v_s', 'sigma0', 'sigma1')}
 #: every friction parameter a declared law may fit
-FRICTION_FITTED = LAW_PARAMS['exponential']
+FRICTION_FITTED = LAW_PARAMS['dynamic']
 
 #: Effects the ladder adds, from the one library of :mod:`ipfric_core.ident.effects` (the base
 #: law's coulomb, stribeck and presliding are the declared friction here).
-LADDER_EFFECTS = ('deadzone', 'saturation', 'delay', 'cogging', 'asymmetry', 'offset', 'sensor_bias', 'backlash',
-                  'drive_backlash')
+LADDER_EFFECTS = ('deadzone', 'saturation', 'delay', 'lag', 'cogging', 'asymmetry', 'offset', 'sensor_bias',
+                  'backlash', 'drive_backlash')
 #: the effects' parameters that are fields of PlantTruth (all of them)
 TRUTH_PARAMS = tuple(n for e in LADDER_EFFECTS for n in EFFECTS[e].params)
 
@@ -77,7 +78,7 @@ class ModelVectors:
 class Model:
     """A declared plant and friction law plus added effects, with every parameter."""
 
-    law: str                       # viscous, coulomb or exponential (declared)
+    law: str                       # viscous, coulomb, exponential or dynamic (a key of LAW_PARAMS)
     params: tuple                  # Param, in order
     effects: tuple = ()            # names of EFFECTS added, in order
     gamma: float = 2.0             # Stribeck form factor (declared, not fitted)
@@ -115,15 +116,46 @@ class Model:
         bad = [n for n in names if n not in PLANT_KNOWN]
         if bad:
             raise ConfigError(f'--free: {", ".join(bad)} is not a plant constant; allowed: {", ".join(PLANT_KNOWN)}')
+        return self.with_free(names)
+
+    def with_free(self, names) -> Model:
+        """This model with the parameters ``names`` fitted (the others as they are)."""
         return replace(self, params=tuple(replace(p, free=True) if p.name in names else p for p in self.params))
+
+    def with_bounds(self, name: str, lo: float, hi: float) -> Model:
+        """This model with parameter ``name`` confined to [lo, hi] (within its physical range)."""
+        return replace(self, params=tuple(replace(p, lo=max(p.lo, lo), hi=min(p.hi, hi)) if p.name == name else p
+                                          for p in self.params))
+
+    def fitted(self, names) -> bool:
+        """True when every parameter of ``names`` this model has is fitted."""
+        return all(p.free for p in self.params if p.name in names)
+
+    def with_law(self, law: str, starts: dict) -> Model:
+        """This model with the friction law ``law`` (one of :data:`LAW_PARAMS`): its parameters fitted, at
+        this model's values where it has them, else at ``starts``; the plant and the effects kept."""
+        own = set(LAW_PARAMS[law])
+        kept = [p for p in self.params if p.name not in FRICTION_FITTED]
+        new = [param(n, self.get(n, starts[n]) if any(p.name == n for p in self.params) else starts[n], True)
+               for n in LAW_PARAMS[law] if n in own]
+        plant = [p for p in kept if p.name in PLANT_KNOWN]
+        rest = [p for p in kept if p.name not in PLANT_KNOWN]
+        return replace(self, law=law, params=tuple(plant + new + rest))
+
+    def without(self, effect: str) -> Model:
+        """This model without effect ``effect`` (and its parameters)."""
+        own = set(EFFECTS[effect].params)
+        return replace(self, params=tuple(p for p in self.params if p.name not in own),
+                       effects=tuple(e for e in self.effects if e != effect))
 
     def friction_params(self) -> FrictionParams:
         """The friction law with its fitted values as coefficients (F_N = normal_force)."""
         fn = self.normal_force
         fc = self.get('Fc')
+        bristle = {k: self[k] for k in ('sigma0', 'sigma1')} if self.law == 'dynamic' else {}
         return FrictionParams(model=self.law, eps=self['eps'], mu_c=fc / fn,
                               mu_s=(fc + self.get('Fs_excess')) / fn, v_s=self.get('v_s', 0.105),
-                              gamma=self.gamma)
+                              gamma=self.gamma, **bristle)
 
     def plant_params(self) -> PlantParams:
         return PlantParams(M=self['M'], m=max(self['m'], 1e-6), l=self['l'], g=self.g,
@@ -148,15 +180,15 @@ class Model:
 
 
 def declared(plant: PlantParams, friction: FrictionParams, pendulum: bool) -> Model:
-    """The declared model: the plant's constants frozen, the friction law's values free."""
+    """The declared model, every parameter at its declared value and none fitted."""
     fn = plant.normal_force if pendulum else plant.M * plant.g
     if friction.model not in LAW_PARAMS:
         raise ConfigError(f'friction.model: {friction.model!r} cannot be identified; allowed: '
                           f'{", ".join(LAW_PARAMS)}')
     params = [param(k, getattr(plant, k), False) for k in PLANT_KNOWN]
     values = {'Fc': friction.mu_c * fn, 'Fs_excess': (friction.mu_s - friction.mu_c) * fn,
-              'eps': friction.eps, 'v_s': friction.v_s}
-    params += [param(k, values[k], True) for k in LAW_PARAMS[friction.model]]
+              'eps': friction.eps, 'v_s': friction.v_s, 'sigma0': friction.sigma0, 'sigma1': friction.sigma1}
+    params += [param(k, values[k], False) for k in LAW_PARAMS[friction.model]]
     return Model(friction.model, tuple(params), (), friction.gamma, plant.g, fn, pendulum)
 
 

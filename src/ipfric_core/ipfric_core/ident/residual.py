@@ -1,4 +1,4 @@
-"""Residual analysis: whiteness, correlation with the input, and effect signatures.
+"""Residual analysis: the signatures of effects in a force residual.
 
 All functions take the residual r [N] of the force balance on the samples used in the
 fit, with the signals at the same samples. A signature score is the share of the
@@ -9,17 +9,10 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ['whiteness', 'time_since_reversal', 'SIGNATURES', 'signature_scores']
+__all__ = ['time_since_reversal', 'SIGNATURES', 'signature_scores']
 
 MAX_LAG = 25
 BINS = 20
-
-
-def autocorrelation(r: np.ndarray, max_lag: int = MAX_LAG) -> np.ndarray:
-    """Normalized autocorrelation rho(0..max_lag) of r."""
-    r = np.asarray(r, float) - np.mean(r)
-    den = float(r @ r) or 1.0
-    return np.array([float(r[:len(r) - k] @ r[k:]) / den for k in range(max_lag + 1)])
 
 
 def cross_correlation(r: np.ndarray, u: np.ndarray, max_lag: int = MAX_LAG) -> np.ndarray:
@@ -32,25 +25,6 @@ def cross_correlation(r: np.ndarray, u: np.ndarray, max_lag: int = MAX_LAG) -> n
     for k in range(-max_lag, max_lag + 1):
         out.append(float(r[k:] @ u[:n - k]) / den if k >= 0 else float(r[:n + k] @ u[-k:]) / den)
     return np.array(out)
-
-
-def band(n: int) -> float:
-    """95 % band of a correlation estimate of white noise over n samples: 1.96 / sqrt(n)."""
-    return 1.96 / np.sqrt(max(n, 1))
-
-
-def whiteness(r: np.ndarray, u: np.ndarray, max_lag: int = MAX_LAG) -> dict:
-    """Whiteness test: autocorrelation (lags 1..max_lag) and cross-correlation with the input.
-
-    White when at most 5 % of the lags (plus one) fall outside the 95 % band, for both.
-    """
-    acf, ccf, b = autocorrelation(r, max_lag), cross_correlation(r, u, max_lag), band(len(r))
-    out_acf = int(np.sum(np.abs(acf[1:]) > b))
-    out_ccf = int(np.sum(np.abs(ccf) > b))
-    allowed = 1 + int(0.05 * max_lag)
-    return {'white': bool(out_acf <= allowed and out_ccf <= 2 * allowed), 'band': float(b),
-            'acf_outside': out_acf, 'ccf_outside': out_ccf, 'acf': acf.tolist(), 'ccf': ccf.tolist(),
-            'max_lag': max_lag}
 
 
 def eta_squared(r: np.ndarray, var: np.ndarray, bins: int = BINS) -> float:

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numba
 import numpy as np
@@ -27,11 +28,11 @@ import numpy as np
 from ..analysis.records import Record, smooth_rate
 from ..physics.compiled import compiled
 from ..physics.plant import motor_force, motor_side_free
-from ..physics.rig import delayed_means, delayed_pieces, input_effects, inputs_through, play
+from ..physics.rig import drive_means, drive_pieces, input_effects, inputs_through, play
 from ..physics.simulate import advance, advance_drive
 
-__all__ = ['every', 'cart_windows', 'angle_windows', 'drive_states', 'applied_commands', 'predict',
-           'reading_errors', 'summary', 'window_sse']
+__all__ = ['every', 'cart_windows', 'angle_windows', 'drive_states', 'applied_commands', 'predict', 'windows_at',
+           'quantization_floor', 'reading_errors', 'summary', 'window_sse']
 
 CART_WINDOW_S = 1.0
 PENDULUM_WINDOW_S = 0.25
@@ -86,18 +87,20 @@ def still(t: np.ndarray, x: np.ndarray) -> np.ndarray:
 def make_windows(rec: Record, length_s: float, forced: bool = False, span: float = REST_SPAN) -> Windows:
     """Windows of about ``length_s`` [s] over the valid stretches of ``rec``, from one rest of the
     cart to the next where it can (its state is then known: at rest, held by static friction;
-    a window may reach ``span`` times its length for it), else from the measured state with
-    velocities from :func:`local_rate`. With
-    ``forced``, the angle follows the measurement in them (its rate:
-    :func:`~ipfric_core.analysis.records.smooth_rate`)."""
-    t, x = rec.t, rec.x
-    valid = rec.valid_mask & (t >= t[0] + LEAD_S)
-    th = rec.theta if rec.theta is not None else np.zeros_like(x)
-    rest = still(t, x) & valid
+    a window may reach ``span`` times its length for it, a stretch that opens in motion starts
+    at its first rest within that reach), else from the measured state with velocities from
+    :func:`local_rate` (:func:`windows_at`). With ``forced``, the angle follows
+    the measurement in them (its rate: :func:`~ipfric_core.analysis.records.smooth_rate`)."""
+    t = rec.t
+    valid = usable(rec)
+    rest = still(t, rec.x) & valid
     starts, stops = [], []
     edges = np.flatnonzero(np.diff(np.concatenate([[0], valid.astype(int), [0]])))
     for a, b in zip(edges[::2], edges[1::2]):
-        k = a
+        # a stretch that opens in motion starts at its first rest within reach (a rate estimated from
+        # the encoder's counts carries its rounding into a window that lasts seconds)
+        r = np.flatnonzero(rest[a:min(b, int(np.searchsorted(t, t[a] + span * length_s, side='right')))])
+        k = a + int(r[0]) if len(r) else a
         while k < b - 1 and t[b - 1] - t[k] >= 0.3 * length_s:
             # rest to rest: with span > 1 the window ends at the first rest after 0.3 of its
             # length (up to span times its length), else at the last rest in its second half;
@@ -115,8 +118,20 @@ def make_windows(rec: Record, length_s: float, forced: bool = False, span: float
             starts.append(k)
             stops.append(end)
             k = end - 1
-    start, stop = np.array(starts, int), np.array(stops, int)
-    held = rest[start].astype(float)
+    return windows_at(rec, np.array(starts, int), np.array(stops, int), forced)
+
+
+def usable(rec: Record) -> np.ndarray:
+    """Samples a window may hold: valid, and LEAD_S into the record at the earliest."""
+    return rec.valid_mask & (rec.t >= rec.t[0] + LEAD_S)
+
+
+def windows_at(rec: Record, start: np.ndarray, stop: np.ndarray, forced: bool = False) -> Windows:
+    """The windows [start, stop) of ``rec`` with the measured state at each start: at rest where the
+    encoder stood still around it (:func:`still`), else with velocities from :func:`local_rate`."""
+    t, x = rec.t, rec.x
+    th = rec.theta if rec.theta is not None else np.zeros_like(x)
+    held = (still(t, x) & usable(rec))[start].astype(float)
     v = np.array([0.0 if h else local_rate(t, x, k, rec.valid_mask) for k, h in zip(start, held)])
     w = (np.array([local_rate(t, th, k, rec.valid_mask) for k in start]) if rec.theta is not None
          else np.zeros(len(start)))
@@ -183,7 +198,7 @@ def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, drive0, t, 
            start, stop, state, held, substep, forced, angle, out):
     """Encoder readings (x, theta) predicted in every window, written into ``out`` (n, 2). Each
     sample interval k is integrated over its pieces of constant applied command (``first``,
-    ``durations``, ``commands`` of :func:`~ipfric_core.physics.rig.delayed_pieces`), each through
+    ``durations``, ``commands`` of :func:`~ipfric_core.physics.rig.drive_pieces`), each through
     the input effects. Without a pendulum (pp's m = 0) the angle is held at 0; with ``forced`` (n, 2)
     rows, the angle and its rate are set to them (less the bias) after every sample; a free angle more
     than 1.5 rad from the measured one (``angle``) has diverged (the rest of its window is NaN). With a
@@ -222,9 +237,9 @@ def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, drive0, t, 
 
 def applied_commands(model, rec: Record) -> np.ndarray:
     """The mean command reaching the motor over each sample interval: the record's command through
-    the model's delay (:func:`~ipfric_core.physics.rig.delayed_means`), deadzone and saturation."""
+    the model's delay and lag (:func:`~ipfric_core.physics.rig.drive_means`), deadzone and saturation."""
     tr = model.truth
-    u = np.ascontiguousarray(delayed_means(rec.t, rec.u, tr.input_delay_s), float)
+    u = np.ascontiguousarray(drive_means(rec.t, rec.u, tr.input_delay_s, tr.input_lag_s), float)
     return inputs_through(u, tr.deadzone_V, tr.saturation_V)
 
 
@@ -238,16 +253,31 @@ class Prediction:
     window_of: np.ndarray    # window index of each sample (-1 outside)
 
 
+_PIECES: dict = {}
+
+
+def pieces(rec: Record, delay: float, lag: float) -> tuple:
+    """:func:`~ipfric_core.physics.rig.drive_pieces` of the record's command, the last few kept (a fit
+    replays one record through many models with the same delay and lag)."""
+    key = (id(rec.t), id(rec.u), len(rec.t), float(delay), float(lag))
+    if key not in _PIECES:
+        if len(_PIECES) >= 8:
+            _PIECES.pop(next(iter(_PIECES)))
+        first, durations, commands = drive_pieces(rec.t, rec.u, delay, lag)
+        _PIECES[key] = (first, durations, np.ascontiguousarray(commands, float), rec.t, rec.u)
+    return _PIECES[key][:3]
+
+
 def predict(model, rec: Record, win: Windows) -> Prediction:
     """Replay ``rec``'s command through ``model`` (an :class:`ident.model.ModelVectors`)."""
     tr = model.truth
-    first, durations, commands = delayed_pieces(rec.t, rec.u, tr.input_delay_s)
+    first, durations, commands = pieces(rec, tr.input_delay_s, tr.input_lag_s)
     out = np.full((len(rec.t), 2), np.nan)
     drive = tuple(float(v) for v in tr.drive_vector())
     drive0 = (drive_states(model.pp, drive[0], drive[1], rec.t, applied_commands(model, rec), win.motion)[win.start]
               if drive[0] > 0.0 else np.zeros((len(win), 3)))
     _shoot(model.pp, model.fp, tr.force_vector(), tr.deadzone_V, tr.saturation_V, tr.backlash_m, tr.bias_theta_rad,
-           drive, drive0, rec.t, first, durations, np.ascontiguousarray(commands, float), win.start, win.stop,
+           drive, drive0, rec.t, first, durations, commands, win.start, win.stop,
            win.state, win.held, min(1e-3, float(np.median(np.diff(rec.t)))), win.forced,
            rec.theta if rec.theta is not None else np.zeros(len(rec.t)), out)
     window_of = np.full(len(rec.t), -1)
@@ -259,13 +289,13 @@ def predict(model, rec: Record, win: Windows) -> Prediction:
 
 def reading_errors(pred: Prediction, rec: Record, key: str) -> np.ndarray:
     """Simulated minus measured reading of ``key`` ('x' or 'theta') in encoder counts, on the
-    compared samples (a diverged simulation counts 1e4 counts)."""
+    compared samples (a diverged simulation counts 1e4 counts, and no error counts more)."""
     c = pred.compared
     sim, meas, res = ((pred.x, rec.x, rec.x_resolution) if key == 'x'
                       else (pred.theta, rec.theta, rec.theta_resolution))
     assert sim is not None and meas is not None, f'no {key} in the record'
     e = (sim[c] - meas[c]) / res
-    return np.where(np.isfinite(e), e, 1e4)
+    return np.where(np.isfinite(e), np.clip(e, -1e4, 1e4), 1e4)
 
 
 def summary(pred: Prediction, rec: Record, win: Windows, key: str) -> dict:
@@ -282,3 +312,61 @@ def summary(pred: Prediction, rec: Record, win: Windows, key: str) -> dict:
 def window_sse(pred: Prediction, rec: Record, win: Windows, key: str) -> np.ndarray:
     """Sum of squared errors [counts^2] of each window (the unit of the significance test)."""
     return np.bincount(pred.window_of[pred.compared], reading_errors(pred, rec, key) ** 2, len(win))
+
+
+#: samples before a window's start that the floor's perfect model is run from, so that its start state is
+#: estimated from readings on both sides as the measured one is [s]
+FLOOR_LEAD_S = 0.03
+
+
+def quantization_floor(model, rec: Record, win: Windows, key: str) -> dict:
+    """What a perfect model leaves on these windows: the error of ``key`` ('x' or 'theta') in counts and
+    in % of the motion when the data are ``model``'s own motion, read through the record's encoders.
+
+    Each window's motion is simulated from the measured state FLOOR_LEAD_S before its start, rounded to
+    the encoder's grid (the cart's alone where the angle follows the measurement, both for the free
+    angle windows); the window is then shot again from the state estimated from those readings (at rest,
+    or velocities from :func:`local_rate`), as the data are shot. The error that leaves is the
+    encoders' rounding and what it does to the estimated start states: a model that explains the data
+    can do no better. Windows run in two passes (even, odd), so that none overlaps its neighbour."""
+    res = rec.x_resolution if key == 'x' else rec.theta_resolution
+    lead = max(2, int(np.ceil(FLOOR_LEAD_S / rec.dt)))
+    ok = usable(rec)
+    first = np.maximum.accumulate(np.where(ok & ~np.concatenate([[False], ok[:-1]]), np.arange(len(ok)), 0))
+    forced = len(win.forced) > 0
+    sq = motion = 0.0
+    n = 0
+    for parity in (0, 1):
+        pick = np.arange(parity, len(win), 2)
+        if not len(pick):
+            continue
+        start, stop = win.start[pick], win.stop[pick]
+        pre = np.maximum(start - lead, first[start])
+        truth = predict(model, rec, windows_at(rec, pre, stop, forced))
+        synth: dict[str, Any] = {'x': rec.x.copy(), 'theta': None if rec.theta is None else rec.theta.copy()}
+        inside = np.zeros(len(rec.t), bool)
+        for a, b in zip(pre, stop):
+            inside[a:b] = True
+        names = ('x',) if forced or rec.theta is None else ('x', 'theta')
+        for name in names:
+            sim = truth.x if name == 'x' else truth.theta
+            assert sim is not None
+            meas = synth[name]
+            step = rec.x_resolution if name == 'x' else rec.theta_resolution
+            origin = float(meas[ok][0])
+            grid = np.round((sim - origin) / step) * step + origin
+            synth[name] = np.where(inside & np.isfinite(sim), grid, meas)
+        srec = replace(rec, x=synth['x'], theta=synth['theta'])
+        again = predict(model, srec, windows_at(srec, start, stop, forced))
+        c = again.compared & np.isfinite(truth.x)
+        got, meas = (again.x, srec.x) if key == 'x' else (again.theta, srec.theta)
+        assert got is not None and meas is not None
+        assert sim is not None and meas is not None
+        e = (got[c] - meas[c]) / res
+        e = e[np.isfinite(e)]
+        sq += float(e @ e)
+        n += len(e)
+        base = meas[start[again.window_of[c]]]
+        motion += float(np.sum(((meas[c] - base) / res) ** 2))
+    rms = float(np.sqrt(sq / max(n, 1)))
+    return {f'{key}_floor_counts': rms, f'{key}_floor_percent': float(100 * np.sqrt(sq) / max(np.sqrt(motion), 1.0))}

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..physics.params import ConfigError, FrictionParams, PlantParams
 from ..run.scenario import Scenario
-from .model import FRICTION_FITTED, PLANT_KNOWN, Model, declared
+from .model import FRICTION_FITTED, Model, declared
 
 __all__ = ['friction_cases', 'report_draws']
 
@@ -44,7 +44,7 @@ def load_report(path: str | Path) -> tuple[Model, dict[str, float], float]:
     model = declared(PlantParams(**idf['plant']), FrictionParams(**idf['friction']), r['data']['pendulum'])
     for effect in last['effects']:
         model = model.with_effect(effect)
-    model = model.freeing([p['name'] for p in last['params'] if p['fitted'] and p['name'] in PLANT_KNOWN])
+    model = model.with_free([p['name'] for p in last['params'] if p['fitted']])
     model = model.with_values({p['name']: p['value'] for p in last['params']})
     std = {p['name']: float(p['std']) for p in last['params']
            if p['fitted'] and p['std'] is not None and math.isfinite(p['std']) and p['std'] > 0}

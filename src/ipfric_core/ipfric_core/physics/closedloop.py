@@ -56,11 +56,7 @@ def compiled_unsupported(rig: Rig, controller: StateFeedback) -> str | None:
         return 'the rig has already been stepped'
     if controller.started:
         return 'the controller has already been updated'
-    if rig.effects.noise_x_m or rig.effects.noise_theta_rad:
-        return 'sensor noise (plant_truth.noise_*) is drawn by the python engine only'
-    if rig.effects.drive_backlash_m:
-        return 'a drive with play (plant_truth.drive_backlash_m) is integrated by the python engine only'
-    return None
+    return rig.compiled_unsupported()
 
 
 def run_closed_loop(rig: Rig, controller: StateFeedback, duration: float,

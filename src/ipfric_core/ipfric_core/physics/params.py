@@ -16,8 +16,7 @@ from typing import Any
 import yaml
 
 __all__ = ['FRICTION_MODELS', 'SMOOTHING', 'ConfigError', 'Field', 'check_number', 'check_choice', 'check_keys',
-           'check_fields',
-           'PLANT_FIELDS', 'PlantParams', 'FRICTION_FIELDS', 'FrictionParams', 'load_yaml']
+           'check_fields', 'PLANT_FIELDS', 'PlantParams', 'FRICTION_FIELDS', 'FrictionParams', 'load_yaml']
 
 FRICTION_MODELS = ('viscous', 'coulomb', 'exponential', 'dynamic')
 SMOOTHING = ('none', 'tanh')

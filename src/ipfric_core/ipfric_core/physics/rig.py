@@ -22,7 +22,7 @@ from .plant import CartPendulum
 from .simulate import Simulator
 
 __all__ = ['PlantTruth', 'input_effects', 'inputs_through', 'play', 'sensor_reading', 'RigSpec', 'Rig',
-           'PLANT_TRUTH_FIELDS', 'delayed_pieces', 'delayed_means']
+           'PLANT_TRUTH_FIELDS', 'delayed_pieces', 'drive_pieces', 'drive_means', 'lag_response', 'lagged_commands']
 
 
 #: the schema of :class:`PlantTruth`: unit, range and meaning of every field (its default is the dataclass's)
@@ -36,6 +36,7 @@ PLANT_TRUTH_FIELDS = {
     'deadzone_V': Field('V', 0.0, 100.0, 'input deadzone'),
     'saturation_V': Field('V', 0.0, 1e3, 'drive saturation (0 = none)'),
     'input_delay_s': Field('s', 0.0, 10.0, 'transport delay of the command'),
+    'input_lag_s': Field('s', 0.0, 1.0, 'time constant of the drive\'s first-order lag (amplifier, motor current)'),
     'backlash_m': Field('m', 0.0, 1.0, 'play between cart and its encoder'),
     'drive_backlash_m': Field('m', 0.0, 1.0, 'play between the motor side of the drive and the cart'),
     'drive_mass_kg': Field('kg', 0.0, 100.0, 'motor side of the drive reflected to the rack (with a play)'),
@@ -62,6 +63,8 @@ class PlantTruth:
     saturation_V : the drive cannot apply more than this [V] (0 = no limit)
     input_delay_s : transport delay of the command [s] (:func:`delayed_pieces`); a rig runs
         whole samples of it
+    input_lag_s : time constant of a first-order lag between the (delayed) command and the voltage
+        the motor sees (an amplifier, a current loop) [s] (:func:`lag_response`)
     backlash_m : play between cart and its position encoder (rack and pinion) [m]
     drive_backlash_m : play between the motor side of the drive and the cart [m]; the motor
         side (rotor and gears reflected to the rack) crosses it without pushing the cart
@@ -83,6 +86,7 @@ class PlantTruth:
     deadzone_V: float = 0.0
     saturation_V: float = 0.0
     input_delay_s: float = 0.0
+    input_lag_s: float = 0.0
     backlash_m: float = 0.0
     drive_backlash_m: float = 0.0
     drive_mass_kg: float = 0.0
@@ -152,6 +156,8 @@ def delayed_pieces(t, u, delay: float) -> tuple[np.ndarray, np.ndarray, np.ndarr
     """
     t, u = np.asarray(t, float), np.asarray(u, float)
     n = len(t)
+    if delay <= 0.0:
+        return np.arange(n), np.diff(t), u[:max(n - 1, 0)].copy()
     tol = 1e-9 * float(np.median(np.diff(t))) if n > 1 else 0.0
     switches = t + delay
     near = np.clip(np.searchsorted(t, switches), 0, n - 1)
@@ -167,16 +173,47 @@ def delayed_pieces(t, u, delay: float) -> tuple[np.ndarray, np.ndarray, np.ndarr
     return first, np.diff(edges), values
 
 
-def delayed_means(t, u, delay: float) -> np.ndarray:
-    """The mean command the drive applies over each sample interval through a transport delay
-    (:func:`delayed_pieces`); at the last sample, the command applied there. Without a delay: ``u``."""
+def drive_pieces(t, u, delay: float = 0.0, lag: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The command as the motor sees it before the deadzone and saturation: through the transport delay
+    (:func:`delayed_pieces`) and the lag (:func:`lagged_commands`, each piece's mean); the pieces of
+    :func:`delayed_pieces`."""
+    first, durations, commands = delayed_pieces(t, u, delay)
+    if lag > 0.0:
+        commands = lagged_commands(durations, np.ascontiguousarray(commands, float), lag)
+    return first, durations, commands
+
+
+def drive_means(t, u, delay: float = 0.0, lag: float = 0.0) -> np.ndarray:
+    """The mean command the motor sees over each sample interval (:func:`drive_pieces`); at the last
+    sample, the last piece's. Without a delay or lag: ``u``."""
     u = np.asarray(u, float)
-    if delay <= 0.0:
+    if delay <= 0.0 and lag <= 0.0:
         return u
-    first, durations, values = delayed_pieces(t, u, delay)
-    means = np.add.reduceat(durations * values, first[:-1]) / np.add.reduceat(durations, first[:-1])
-    last = np.searchsorted(t, t[-1] - delay, side='right') - 1
-    return np.concatenate([means, [u[max(last, 0)]]])
+    first, durations, commands = drive_pieces(t, u, delay, lag)
+    means = np.add.reduceat(durations * commands, first[:-1]) / np.add.reduceat(durations, first[:-1])
+    return np.concatenate([means, commands[-1:]])
+
+
+@compiled
+def lag_response(state: float, command: float, tau: float, h: float):
+    """A first-order lag, tau v' = command - v, over ``h`` [s] with ``command`` held, from v = ``state``:
+    (mean of v over the interval, v at its end) [V]; the mean is what the drive applies over it (the
+    force's impulse is exact). Without a lag (tau = 0): (command, command)."""
+    if tau <= 0.0:
+        return command, command
+    e = math.exp(-h / tau)
+    return command + (state - command) * tau / h * (1.0 - e), command + (state - command) * e
+
+
+@compiled
+def lagged_commands(durations, commands, tau: float):
+    """:func:`lag_response` along pieces of held command (``durations`` [s], ``commands``), from rest at
+    the first command: the mean voltage over each piece."""
+    out = np.empty(len(commands))
+    v = commands[0] if len(commands) else 0.0
+    for j in range(len(commands)):
+        out[j], v = lag_response(v, commands[j], tau, durations[j])
+    return out
 
 
 def apply_input_effects(voltage: float, truth: PlantTruth) -> float:
@@ -256,6 +293,7 @@ class Rig:
         self.sim = Simulator(model, state0, extra_force=truth.force_vector(), drive=truth.drive_vector())
         n = round(truth.input_delay_s / dt)
         self._pending = deque([0.0] * n)
+        self._lagged = 0.0
         self._rng = random.Random(truth.noise_seed)
         self._backlash_x = self.sim.state[0]
         self.k = 0
@@ -280,7 +318,8 @@ class Rig:
     def step(self, voltage: float) -> None:
         """Hold ``voltage`` [V] (as commanded) for one sample period."""
         self._pending.append(voltage)
-        v = apply_input_effects(self._pending.popleft(), self.effects)
+        v, self._lagged = lag_response(self._lagged, self._pending.popleft(), self.effects.input_lag_s, self.dt)
+        v = apply_input_effects(v, self.effects)
         self.voltage_applied = v
         self.sim.step(v, self.dt)
         self.k += 1
@@ -294,7 +333,11 @@ class Rig:
                 'voltage_applied': self.voltage_applied}
 
     def loop_spec(self) -> RigSpec:
-        """The rig's settings and current state as numbers (see :class:`RigSpec`)."""
+        """The rig's settings and current state as numbers (see :class:`RigSpec`); ValueError for an effect
+        the compiled loop does not carry (:meth:`compiled_unsupported`)."""
+        why = self.compiled_unsupported()
+        if why:
+            raise ValueError(f'the compiled loop cannot run this rig: {why}')
         e, sim = self.effects, self.sim
         return RigSpec(plant=sim.model.vector, friction=sim.model.friction.vector, extra_force=sim.extra_force,
                        state=sim.state_tuple, mode=sim.mode, substep=sim.substep, dt=float(self.dt),
@@ -302,6 +345,17 @@ class Rig:
                        sensors=(float(e.bias_x_m), float(e.bias_theta_rad), float(e.backlash_m)),
                        drive=(float(e.deadzone_V), float(e.saturation_V), float(len(self._pending))),
                        limits=(float(self.track_limit), float(self.fallen_angle)))
+
+    def compiled_unsupported(self) -> str | None:
+        """The effect of this rig the compiled loop does not carry (the python engine does), or None."""
+        e = self.effects
+        if e.noise_x_m or e.noise_theta_rad:
+            return 'sensor noise (plant_truth.noise_*) is drawn by the python engine only'
+        if e.drive_backlash_m:
+            return 'a drive with play (plant_truth.drive_backlash_m) is integrated by the python engine only'
+        if e.input_lag_s:
+            return 'a drive lag (plant_truth.input_lag_s) is applied by the python engine only'
+        return None
 
     def limit_violation(self):
         """None, or (code, detail) when the track or fallen limit is crossed."""

@@ -24,7 +24,18 @@ from __future__ import annotations
 import math
 
 from .compiled import compiled
-from .friction import friction_force, holding_margin, holds, sticks
+from .friction import (
+    DYNAMIC,
+    FP_EPS,
+    FP_MODEL,
+    FP_SIGMA0,
+    FP_SIGMA1,
+    friction_force,
+    holding_margin,
+    holds,
+    sliding_level,
+    sticks,
+)
 from .plant import (
     NO_EXTRA_FORCE,
     CartPendulum,
@@ -41,7 +52,8 @@ __all__ = ['held', 'advance', 'advance_drive', 'friction_now', 'Simulator']
 
 MAX_EVENTS = 64  # per substep; a guard, never reached in normal motion
 XTOL = 1e-13     # event time tolerance [s]
-CONTACT_STEPS = 40       # steps per period of the drive's contact oscillation
+CONTACT_STEPS = 40       # steps per period of the drive's contact oscillation (and of the bristles')
+MAX_BRISTLE_STEPS = 1000  # steps of the dynamic law within one substep at most
 NO_DRIVE = (0.0, 0.0, 0.0, 0.0)   # (play [m], motor-side mass [kg], stiffness [N/m], damping [N s/m]): rigid
 
 
@@ -190,8 +202,24 @@ def _advance_hybrid(pp, fp, ef, s, mode, h, voltage):
 
 
 @compiled
+def bristle_step(pp, fp, v: float, h: float) -> float:
+    """Largest RK4 step [s] of the dynamic law (eqs. 10-11) at speed ``v`` [m/s]: ``h``, CONTACT_STEPS
+    per period 2 pi sqrt(M / sigma0) of the bristles' oscillation with the cart, and at most 1 over the
+    bristles' relaxation rate sigma0 |v| / g(v) and the damping rate (sigma1 + eps) / M (RK4 is stable
+    to 2.8 over a rate); no more than MAX_BRISTLE_STEPS steps in ``h``. ``h`` for the other laws."""
+    if fp[FP_MODEL] != DYNAMIC:
+        return h
+    step = min(h, 2.0 * math.pi * math.sqrt(pp[0] / fp[FP_SIGMA0]) / CONTACT_STEPS)
+    rate = max(fp[FP_SIGMA0] * abs(v) / sliding_level(fp, v), (fp[FP_SIGMA1] + fp[FP_EPS]) / pp[0])
+    if rate * step > 1.0:
+        step = 1.0 / rate
+    return max(step, h / MAX_BRISTLE_STEPS)
+
+
+@compiled
 def advance(pp, fp, ef, s, mode, voltage, dt, substep):
-    """State and mode after ``dt`` [s] with ``voltage`` [V] held, in RK4 substeps <= ``substep``."""
+    """State and mode after ``dt`` [s] with ``voltage`` [V] held, in RK4 substeps <= ``substep``
+    (shorter where the dynamic law's bristles are stiff: :func:`bristle_step`)."""
     n = max(1, math.ceil(dt / substep - 1e-9))
     h = dt / n
     hybrid = sticks(fp)
@@ -199,7 +227,11 @@ def advance(pp, fp, ef, s, mode, voltage, dt, substep):
         if hybrid:
             s, mode = _advance_hybrid(pp, fp, ef, s, mode, h, voltage)
         else:
-            s = rk4_slide(pp, fp, ef, s, h, voltage, mode[1])
+            rest = h
+            while rest > 1e-12 * h:
+                hk = min(rest, bristle_step(pp, fp, s[2], rest))
+                s = rk4_slide(pp, fp, ef, s, hk, voltage, mode[1])
+                rest -= hk
     return s, mode
 
 

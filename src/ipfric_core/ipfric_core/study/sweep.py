@@ -43,8 +43,8 @@ from .variants import (
     scenario_at,
 )
 
-__all__ = ['FIELDS', 'sweep', 'grid', 'boundaries', 'parse_range', 'resolution_study', 'threshold_angle',
-           'map_study', 'figure_study', 'resolution_report', 'threshold_report']
+__all__ = ['FIELDS', 'sweep', 'grid', 'boundaries', 'parse_range', 'resolution_study', 'threshold_angle', 'map_study',
+           'figure_study', 'resolution_report', 'threshold_report']
 
 FIELDS = ('tau_s', 'theta0_deg', 'class', 'transition_time_s', 'x_p2p_m', 'theta_p2p_rad', 'period_s')
 
