@@ -14,6 +14,7 @@ import numpy as np
 import yaml
 
 from ipfric_core.run.runner import executable, pick_domain, ros_environment
+from ipfric_core.run.scenario import SECTION_KEYS
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = ROOT / 'config'
@@ -24,7 +25,7 @@ def scenario_file(tmp_path: Path, name: str, sim: dict | None = None, controller
     """config/<name>.yaml with entries of the two sections replaced (dotted keys nest)."""
     data = yaml.safe_load((CONFIG / name).read_text())
     for section, changes in (('sim_node', sim), ('controller_node', controller)):
-        params = data[section]['ros__parameters']
+        params = data[SECTION_KEYS[section]]['ros__parameters']
         for key, value in (changes or {}).items():
             node = params
             *path, leaf = key.split('.')
