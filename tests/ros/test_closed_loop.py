@@ -86,10 +86,12 @@ def test_lockstep_equals_offline_closed_loop(runs):
 def test_recorded_counts_equal_published_counts(runs):
     res, bag = runs('fig7_old_gain_exponential')
     n = res.samples
-    assert res.published == {'/clock': n, 'joint_states': n, 'plant_state': n, 'safety_event': 2}
+    diagnostics = (n - 1) // 1000                         # one per second of simulated time
+    assert res.published == {'/clock': n, '/joint_states': n, '/plant_state': n, '/safety_event': 2,
+                             '/diagnostics': diagnostics}
     assert res.counts_match
     assert bag.counts == {'/clock': n, '/joint_states': n, '/plant_state': n, '/voltage_command': n,
-                          '/safety_event': 2, '/controller_gain': 1}
+                          '/safety_event': 2, '/controller_gain': 1, '/diagnostics': diagnostics}
     # the controller's own count (logged at its shutdown) equals the recorded commands
     log = (res.out and open(f'{res.out}/logs/controller_node.log').read())
     assert f'published {n} commands' in log

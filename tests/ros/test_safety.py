@@ -80,7 +80,8 @@ def test_sim_refuses_nan_inf_and_out_of_range_commands(tmp_path):
                                  lambda m: applied.__setitem__(m.sample_index, m.voltage_applied),
                                  topics.data_qos())
         sim = start_node('sim_node', ['--params-file', str(cfg), '-p', 'start_timeout_s:=20.0',
-                                      '-p', f'result_file:={tmp_path / "result.json"}'],
+                                      '-p', f'result_file:={tmp_path / "result.json"}',
+                                      '-p', 'wait_for_recorder:=false', '-p', 'controller_node:=/fake_controller'],
                          peer.domain, tmp_path / 'sim.log')
         peer.spin_until(lambda: any(e.code == 'END' for e in events), 60, 'the END event')
         assert sim.wait(timeout=30) == 0
@@ -123,7 +124,8 @@ def test_controller_skips_nan_measurements_and_validates_parameters(tmp_path):
                                  lambda m: cmds.__setitem__(m.sample_index, m), topics.data_qos())
         node.create_subscription(Float64MultiArray, topics.CONTROLLER_GAIN,
                                  lambda m: gains.append(list(m.data)), topics.latched_qos())
-        ctl = start_node('controller_node', ['--params-file', str(cfg), '-p', 'use_sim_time:=true'],
+        ctl = start_node('controller_node', ['--params-file', str(cfg), '-p', 'use_sim_time:=true',
+                                             '-p', 'rig_node:=/fake_sim', '-p', 'min_command_subscribers:=1'],
                          peer.domain, tmp_path / 'controller.log')
         peer.spin_until(lambda: gains and js_pub.get_subscription_count() >= 1, 60, 'the controller')
         assert gains[0] == [70.7107, 304.9273, 143.3152, 61.0833]
@@ -185,7 +187,10 @@ def test_controller_designs_the_gain_at_start_up(tmp_path):
         # the controller announces itself once a command subscription exists
         from ipfric_msgs.msg import VoltageCommand
         peer.node.create_subscription(VoltageCommand, topics.VOLTAGE_COMMAND, lambda m: None, topics.data_qos())
-        ctl = start_node('controller_node', ['--params-file', str(cfg)], peer.domain, tmp_path / 'ctl.log')
+        from sensor_msgs.msg import JointState
+        peer.node.create_publisher(JointState, topics.JOINT_STATES, topics.data_qos())   # the rig, as the controller
+        ctl = start_node('controller_node', ['--params-file', str(cfg), '-p', 'rig_node:=/gain_listener',
+                                             '-p', 'min_command_subscribers:=1'], peer.domain, tmp_path / 'ctl.log')
         peer.spin_until(lambda: gains, 60, 'controller_gain')
     finally:
         peer.close()
