@@ -199,3 +199,44 @@ def test_controller_designs_the_gain_at_start_up(tmp_path):
             assert ctl.wait(timeout=30) == 0
     assert gains[0] == pytest.approx([70.7107, 304.9273, 143.3152, 61.0833], rel=1e-4)
     assert 'designed by LQR on the exponential friction model' in (tmp_path / 'ctl.log').read_text()
+
+
+def test_a_parameter_request_sent_as_the_run_ends_is_answered(tmp_path):
+    """`ros2 param set /sim_node ...` sent in the last samples of a run: the simulator answers it (a
+    refusal, its parameters are read-only) before its services go, instead of leaving the caller hanging."""
+    from rcl_interfaces.srv import SetParameters
+    from rclpy.parameter import Parameter
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float64MultiArray
+
+    from ipfric_msgs.msg import VoltageCommand
+    cfg = scenario_file(tmp_path, 'fig7_old_gain_exponential.yaml', sim={'duration': 0.5})
+    peer = Peer('fake_controller')
+    sim = None
+    try:
+        node = peer.node
+        cmd_pub = node.create_publisher(VoltageCommand, topics.VOLTAGE_COMMAND, topics.data_qos())
+        gain_pub = node.create_publisher(Float64MultiArray, topics.CONTROLLER_GAIN, topics.latched_qos())
+        gain_pub.publish(Float64MultiArray(data=[0.0, 0.0, 0.0, 0.0]))
+        client = node.create_client(SetParameters, '/sim_node/set_parameters')
+        calls = []
+
+        def on_joints(msg):
+            k = round(topics.stamp_to_ns(msg.header.stamp) / 1e6)
+            if k == 450:                                 # 50 samples before the end
+                req = SetParameters.Request(parameters=[Parameter('theta0', value=0.1).to_parameter_msg()])
+                calls.append(client.call_async(req))
+            cmd_pub.publish(VoltageCommand(voltage=0.0, measurement_stamp=msg.header.stamp, sample_index=k))
+        node.create_subscription(JointState, topics.JOINT_STATES, on_joints, topics.data_qos())
+        sim = start_node('sim_node', ['--params-file', str(cfg), '-p', 'wait_for_recorder:=false',
+                                      '-p', 'controller_node:=/fake_controller'], peer.domain, tmp_path / 'sim.log')
+        peer.spin_until(client.service_is_ready, 60, 'the parameter service')
+        peer.spin_until(lambda: calls and calls[0].done(), 30, 'the answer to a request sent as the run ends')
+        assert sim.wait(timeout=30) == 0
+    finally:
+        peer.close()
+        if sim is not None and sim.poll() is None:
+            sim.kill()
+            sim.wait()
+    answer = calls[0].result().results[0]
+    assert not answer.successful and 'read-only' in answer.reason

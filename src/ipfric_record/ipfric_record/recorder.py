@@ -56,6 +56,8 @@ __all__ = ['END_WAIT_S', 'Recorder', 'make_typestore', 'main']
 
 #: [s] after a stop request, the longest wait for the run's terminal event
 END_WAIT_S = 4.0
+#: executor callbacks (parameter events, service requests) taken at each of its turns
+TURNS = 20
 PARAMETER_EVENT_TYPE = 'rcl_interfaces/msg/ParameterEvent'
 
 
@@ -104,7 +106,7 @@ class Recorder(Node):
             resolved = self.resolve_topic_name(name)
             self.writer.add_topic(resolved, type_name, qos_dict(depth=depth, transient_local=latched))
             qos = topics.latched_qos() if latched else topics.data_qos(topics.RECORD_DEPTH)
-            sub = self.create_subscription(cls, name, self._writer_for(resolved), qos, raw=True)
+            sub = self.create_subscription(cls, name, lambda _: None, qos, raw=True, callback_group=topics.OwnLoop())
             self.subs.append((sub, resolved))
         self.sub_events = next(s for s, name in self.subs if name.endswith('/' + topics.SAFETY_EVENT))
         self.writer.add_topic(topics.PARAMETER_EVENTS, PARAMETER_EVENT_TYPE, qos_dict(depth=1000))
@@ -120,11 +122,6 @@ class Recorder(Node):
         """
         self._last_ns = max(time.time_ns(), self._last_ns)
         return self._last_ns
-
-    def _writer_for(self, name):
-        def on_message(data):
-            self.write(name, data)
-        return on_message
 
     def write(self, name: str, data) -> None:
         """One serialized message of topic ``name`` into the bag (a terminal event noted)."""
@@ -155,8 +152,8 @@ class Recorder(Node):
         Waits on the subscriptions alone, then takes everything queued: waking once per batch
         of messages instead of once per message (as an executor does) keeps the recorder's
         CPU load low at 4 messages per sample; after each wake-up it sleeps ``batch`` s so
-        that messages accumulate. Parameter services and parameter events are served by an
-        executor turn every half second.
+        that messages accumulate. Parameter services and parameter events are served by
+        executor turns every half second.
         """
         executor = SingleThreadedExecutor()
         executor.add_node(self)
@@ -173,12 +170,15 @@ class Recorder(Node):
             if stopped_at is not None and (self.end_event is not None or stop.count > 1
                                            or not self.sub_events.get_publisher_count()
                                            or time.monotonic() - stopped_at > END_WAIT_S):
+                for _ in range(TURNS):                   # the last parameter events
+                    executor.spin_once(timeout_sec=0.0)
                 break
             self.waiter.wait(0.1 if stopped_at is None else 0.02)
             if self.drain():
                 time.sleep(batch)
             if time.monotonic() >= next_turn or stopped_at is not None:
-                executor.spin_once(timeout_sec=0.0)
+                for _ in range(TURNS):
+                    executor.spin_once(timeout_sec=0.0)
                 next_turn = time.monotonic() + 0.5
 
     def close(self, stopped_by: str | None) -> None:
