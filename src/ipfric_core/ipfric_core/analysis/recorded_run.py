@@ -63,16 +63,18 @@ def parameter_changes(run: RunData) -> list[dict]:
 
 
 def parameter_regimes(run: RunData, changes: list[dict], resolution, fallen: float) -> list[dict]:
-    """The run cut at its parameter changes: each stretch as one regime (class, amplitudes, periods)."""
+    """The run cut where a change gave a parameter a new value: each stretch as one regime (class,
+    amplitudes, periods) and the changes it starts with."""
     if not changes or len(run.t) < 2:
         return []
-    cuts = [float(run.t[0])] + sorted({c['t'] for c in changes if run.t[0] < c['t'] < run.t[-1]}) + [float(run.t[-1])]
+    moved = [c for c in changes if c['after'] != c['before']]
+    cuts = [float(run.t[0])] + sorted({c['t'] for c in moved if run.t[0] < c['t'] < run.t[-1]}) + [float(run.t[-1])]
     out = []
     for a, b in zip(cuts, cuts[1:]):
         if b - a < 2 * (run.t[1] - run.t[0]):
             continue
         out.append({**regime_of(run.t, run.x, run.theta, a, b, resolution, fallen).to_dict(),
-                    'after': [f'{c["parameter"]} {c["after"]}' for c in changes if c['t'] == a]})
+                    'after': [f'{c["parameter"]} {c["after"]}' for c in moved if c['t'] == a]})
     return out
 
 
