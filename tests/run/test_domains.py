@@ -46,3 +46,7 @@ def test_rigs_in_different_namespaces_share_a_domain_but_not_a_namespace():
     lock = DomainLock(domain)
     assert lock.acquire() is None
     lock.release()
+
+
+def test_the_last_domain_is_probed_within_the_port_range():
+    assert domain_in_use(232) in (True, False)

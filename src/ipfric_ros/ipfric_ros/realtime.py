@@ -8,7 +8,8 @@ whole process (every thread, the middleware's included) when the loop starts:
   whenever Python decides, which can be in the middle of a sample);
 - ``realtime_priority``: SCHED_FIFO at this priority (1..98; 0 = normal scheduling); refused
   without the privilege (CAP_SYS_NICE or an rtprio limit), which is logged, and the loop
-  runs on at normal priority;
+  runs on at normal priority. The simulator uses it in realtime only: a lockstep loop runs
+  flat out, and at real-time priority it starved its own middleware threads;
 - ``cpu``: the CPU the process is bound to (-1 = any); refused CPUs are logged likewise.
 """
 from __future__ import annotations

@@ -44,6 +44,7 @@ import sys
 import time
 from array import array
 from collections import Counter
+from dataclasses import replace
 
 import numpy as np
 from builtin_interfaces.msg import Time
@@ -334,12 +335,14 @@ class SimNode(Node):
         return self._command
 
     def _serve(self) -> None:
-        """Every 100 samples: an executor turn (parameter services, the gain), the graph checked
-        for intruders, and every second of simulated time the diagnostics."""
+        """Every 100 samples an executor turn (parameter services, the gain); every second of
+        simulated time the graph checked for intruders and the diagnostics (graph queries take
+        a fraction of a sample: rare enough to stay out of the latency's 99th percentile)."""
         self._executor.spin_once(timeout_sec=0.0)
-        self._check_intruders()
-        if self.rig.k and self.rig.k % self.diagnostics_every == 0:
-            self._diagnose(time.monotonic())
+        if self.rig.k % self.diagnostics_every == 0:
+            self._check_intruders()
+            if self.rig.k:
+                self._diagnose(time.monotonic())
 
     def _diagnose(self, now: float) -> None:
         """diagnostic_msgs/DiagnosticArray of the loop since the last one: rate, stale samples, latency."""
@@ -365,6 +368,13 @@ class SimNode(Node):
         msg.header.stamp = self._stamp(self.rig.k)
         self.pub_diagnostics.publish(msg)
         self.published[self.pub_diagnostics.topic_name] += 1
+
+    def _chores(self, tuning: LoopTuning) -> bool:
+        """Realtime: what a sample needs besides its loop, done in its slack; False (done)."""
+        if self.rig.k % 100 == 0:
+            self._serve()
+        tuning.after_sample(self.rig.k)
+        return False
 
     def _stall(self, k: int, now: float) -> None:
         """No valid command for WATCHDOG_WALL_S of wall time: STALL once per episode, watchdog."""
@@ -394,6 +404,8 @@ class SimNode(Node):
         A command computed from sample k arrives during [t_k, t_k+1) and is applied from
         t_k+1 on, as on the real rig. Between samples the loop waits on the command
         subscription until the next deadline; a late sample is taken at once (catching up).
+        Its chores (an executor turn every 100 samples, the garbage collector's) wait until the
+        sample's command is in, so that they never delay taking it.
         """
         period = self.period_ns * 1e-9
         t0 = time.monotonic()
@@ -408,24 +420,27 @@ class SimNode(Node):
                     self.get_logger().warning(f'{late} samples started more than one period late')
                 return end
             self.rig.step(v)
-            if self.rig.k % 100 == 0:
-                self._serve()
-            tuning.after_sample(self.rig.k)
+            chores = True       # executor turn, garbage: once this sample's command is in (off its latency)
             deadline = t0 + self.rig.k * period
             now = time.monotonic()
             if now > deadline + period:
                 late += 1
             while now < deadline and not self.stop:
                 self._take_commands(deadline - now)
+                if chores and self._command is not None:
+                    chores = self._chores(tuning)
                 now = time.monotonic()
             self._take_commands(0.0)
+            if chores:
+                self._chores(tuning)
 
     def run(self) -> int:
         """Wait for peers, run to the end, announce it; the process exit code."""
         if not self.wait_for_peers():
             self.get_logger().info(f'stopped by {self.stop.reason} before the start')
             return 0
-        tuning = LoopTuning(self.tuning, self.get_logger())
+        tuning = LoopTuning(self.tuning if not self.lockstep else replace(self.tuning, realtime_priority=0, cpu=-1),
+                            self.get_logger())
         self.event(START, f'{self.settings.time_mode} run of {self.settings.duration:g} s, '
                             f'friction {self.scenario.friction.model}, theta0 {self.settings.theta0:g} rad'
                             + (f', gain {self.gain}' if self.gain else ''))

@@ -91,10 +91,10 @@ def write_run_scenario(config, out, overrides: dict | None = None, namespace: st
 
 
 #: What the sample loop of a realtime run gets (ipfric_ros.realtime), by node: real-time
-#: scheduling (refused without the privilege, which the nodes log), the simulator and the
-#: controller each on a CPU of its own (0 and 1 of a 2-core machine); the recorder stays at its
-#: default niceness below them.
-REALTIME = {'sim_node': {'realtime_priority': 80, 'cpu': 0}, 'controller_node': {'realtime_priority': 79, 'cpu': 1}}
+#: scheduling of every thread (refused without the privilege, which the nodes log); the recorder
+#: stays at its default niceness below them. Binding each to a CPU of its own was measured and
+#: left out: on 2 cores a process's middleware threads then wait for its loop (docs/ros-stack.md).
+REALTIME = {'sim_node': {'realtime_priority': 80}, 'controller_node': {'realtime_priority': 79}}
 
 
 def node_parameters(scenario, out) -> dict:

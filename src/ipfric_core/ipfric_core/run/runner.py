@@ -97,9 +97,12 @@ def domain_in_use(domain: int) -> bool:
     free one, so the one of participant 0 may be free while later ones still run).
     """
     for participant in range(PARTICIPANTS):
+        port = 7400 + 250 * domain + 10 + 2 * participant
+        if port > 65535:            # the last domains hold fewer participants
+            break
         with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
             try:
-                s.bind(('0.0.0.0', 7400 + 250 * domain + 10 + 2 * participant))
+                s.bind(('0.0.0.0', port))
             except OSError:
                 return True
     return False
@@ -288,6 +291,8 @@ class Run:
     namespace : the rig's ROS namespace (``/rig1``; None = the root); with a given ``domain``,
         rigs in different namespaces share it
     time_mode : lockstep | realtime, overriding the file's (None = keep)
+    node_params : node name -> parameters set on top of what the run gives it (e.g. the loop tuning
+        of :mod:`ipfric_ros.realtime` to compare settings)
     timeout : wall seconds after which the simulator is stopped (None = none)
     grace : wall seconds the simulator may run on after the controller died (its
         watchdog acts) before it is stopped
@@ -295,7 +300,7 @@ class Run:
     """
 
     def __init__(self, config, out, duration: float | None = None, domain: int | None = None,
-                 timeout: float | None = None, grace: float = 20.0, sim_params: dict | None = None,
+                 timeout: float | None = None, grace: float = 20.0, node_params: dict | None = None,
                  stop_wait: float = 20.0, namespace: str | None = None, time_mode: str | None = None):
         self.config = config
         self.out = Path(out).resolve()  # the nodes run with cwd = out
@@ -308,7 +313,7 @@ class Run:
         self.timeout = timeout
         self.grace = grace
         self.stop_wait = stop_wait
-        self.sim_params = dict(sim_params or {})
+        self.node_params = {name: dict(p) for name, p in (node_params or {}).items()}
         self.procs: dict[str, subprocess.Popen] = {}
         self.logs: dict[str, Path] = {}
         self.failures: list[str] = []
@@ -348,7 +353,8 @@ class Run:
         env['ROS_LOG_DIR'] = str(logdir / 'ros')
         env[SUPERVISED] = '1'
         params = node_parameters(cfg, self.out)
-        params['sim_node'][1].update(self.sim_params)
+        for name, extra in self.node_params.items():
+            params[name][1].update(extra)
         args = {name: ros_args(params[name][0], params[name][1], self.namespace) for name in NODES}
         self.t0 = time.monotonic()
         for name in NODES:
