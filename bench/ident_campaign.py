@@ -123,6 +123,7 @@ def identify_case(case_dir: Path, truth: dict, timeout: float = TIMEOUT) -> dict
     env = dict(os.environ, OPENBLAS_NUM_THREADS='1', MKL_NUM_THREADS='1')
     (case_dir / 'ident').mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
+    rc: int | str
     try:
         proc = subprocess.run([sys.executable, '-m', 'ipfric_core.cli', *cmd], cwd=ROOT, env=env,
                               capture_output=True, text=True, timeout=timeout)
@@ -227,7 +228,7 @@ def detection_limit(points: list[tuple[float, bool]], share: float = 0.95, least
 
 
 def summarize(cases: list[dict], threshold: float, meta: dict) -> dict:
-    confusion = defaultdict(Counter)
+    confusion: defaultdict[str, Counter] = defaultdict(Counter)
     for c in cases:
         confusion[c['expected']][c['predicted']] += 1
     per_effect = defaultdict(list)        # name -> [(counts, named right, answer)]
@@ -259,12 +260,12 @@ def summarize(cases: list[dict], threshold: float, meta: dict) -> dict:
     outcomes = Counter(c['outcome'] for c in cases)
     by_setting = {}
     for key in sorted({(c['experiment'], c['theta_column']) for c in cases}):
-        sel = [c for c in cases if (c['experiment'], c['theta_column']) == key]
-        floors = [c['oracle_counts']['x_rms_counts'] for c in sel
+        same = [c for c in cases if (c['experiment'], c['theta_column']) == key]
+        floors = [c['oracle_counts']['x_rms_counts'] for c in same
                   if c.get('oracle_counts') and 'x_rms_counts' in c['oracle_counts']]
         by_setting[f'{key[0]} / {key[1]}'] = dict(
-            n=len(sel), right=sum(c['outcome'] in ('correct', 'acceptable') for c in sel),
-            outcomes=dict(Counter(c['outcome'] for c in sel)),
+            n=len(same), right=sum(c['outcome'] in ('correct', 'acceptable') for c in same),
+            outcomes=dict(Counter(c['outcome'] for c in same)),
             true_model_counts_median=float(np.median(floors)) if floors else None)
     return dict(
         meta=meta, threshold_counts=threshold, n_cases=len(cases), outcomes=dict(outcomes),
