@@ -12,7 +12,7 @@ import sys
 import time
 
 import pytest
-from rosrun import scenario_file
+from rosrun import scenario_file, started
 
 from ipfric_core.analysis.bagread import read_run
 from ipfric_core.constants import REPO_ROOT as ROOT
@@ -21,14 +21,6 @@ from ipfric_core.run.runner import EXIT_FAULT, Run
 pytestmark = pytest.mark.ros
 CFG = ROOT / 'config' / 'default.yaml'
 
-
-def started(log, proc, timeout=90.0):
-    """Until the simulator logged sample 0 (a hang guard, not a timing)."""
-    t0 = time.monotonic()
-    while not (log.exists() and 'START at sample 0' in log.read_text()):
-        assert proc.poll() is None, f'{proc.args[0]} exited'
-        assert time.monotonic() - t0 < timeout, 'the run did not start'
-        time.sleep(0.05)
 
 
 def processes_of(out) -> list[str]:

@@ -6,7 +6,7 @@ import time
 
 import numpy as np
 import pytest
-from rosrun import CONFIG, Peer, scenario_file
+from rosrun import CONFIG, run_beside_peer, scenario_file, started
 
 from ipfric_core.analysis.bagread import read_run
 from ipfric_core.analysis.recorded_run import analyze_run
@@ -17,13 +17,6 @@ from ipfric_core.run.scenario import load_scenario
 
 pytestmark = pytest.mark.ros
 
-
-def started(log, proc, timeout=120.0):
-    t0 = time.monotonic()
-    while not (log.exists() and 'START at sample 0' in log.read_text()):
-        assert proc.poll() is None, f'{proc.args[0]} exited: ' + log.read_text()[-2000:] if log.exists() else ''
-        assert time.monotonic() - t0 < timeout, 'the run did not start'
-        time.sleep(0.05)
 
 
 def test_two_rigs_in_one_domain_each_record_their_own(tmp_path):
@@ -70,12 +63,7 @@ def test_a_run_time_delay_change_is_in_the_bag_and_in_analyze(tmp_path):
 
     from ipfric_ros import topics
     cfg = scenario_file(tmp_path, 'fig9_new_gain_exponential.yaml', sim={'duration': 12.0})
-    r = Run(cfg, tmp_path / 'run', timeout=300)
-    r.start()
-    peer = None
-    try:
-        started(r.logs['sim_node'], r.procs['sim_node'])
-        peer = Peer('lab_user', domain=r.domain)
+    with run_beside_peer(cfg, tmp_path / 'run', 'lab_user') as (r, peer):
         seen = [0]
         peer.node.create_subscription(JointState, topics.JOINT_STATES,
                                       lambda m: seen.__setitem__(0, m.header.stamp.sec), topics.data_qos())
@@ -92,10 +80,6 @@ def test_a_run_time_delay_change_is_in_the_bag_and_in_analyze(tmp_path):
         peer.spin_until(lambda: seen[0] >= 4, 60, 'simulated second 4')
         assert set_delay(0.02).successful
         res = r.wait()
-    finally:
-        if peer is not None:
-            peer.close()
-        r.kill()
     assert res.exit_code == 0, res.summary()
     log = (tmp_path / 'run' / 'logs' / 'controller_node.log').read_text()
     first = int(log.split('delay set to 0.02 (from sample ')[1].split(' ')[0])

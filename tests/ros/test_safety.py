@@ -54,9 +54,18 @@ def test_a_burst_of_refusals_gives_two_events_with_counts():
     assert g.refused == 5000
 
 
+def fake_controller(peer):
+    """The peer as the simulator's controller: its gain announced (latched); its command publisher."""
+    from std_msgs.msg import Float64MultiArray
+
+    from ipfric_msgs.msg import VoltageCommand
+    gain_pub = peer.node.create_publisher(Float64MultiArray, topics.CONTROLLER_GAIN, topics.latched_qos())
+    gain_pub.publish(Float64MultiArray(data=[0.0, 0.0, 0.0, 0.0]))
+    return peer.node.create_publisher(VoltageCommand, topics.VOLTAGE_COMMAND, topics.data_qos())
+
+
 def test_sim_refuses_nan_inf_and_out_of_range_commands(tmp_path):
     from sensor_msgs.msg import JointState
-    from std_msgs.msg import Float64MultiArray
 
     from ipfric_msgs.msg import PlantState, SafetyEvent, VoltageCommand
     bad = {10: math.nan, 20: math.inf, 30: 25.0}
@@ -65,9 +74,7 @@ def test_sim_refuses_nan_inf_and_out_of_range_commands(tmp_path):
     sim = None
     try:
         node = peer.node
-        cmd_pub = node.create_publisher(VoltageCommand, topics.VOLTAGE_COMMAND, topics.data_qos())
-        gain_pub = node.create_publisher(Float64MultiArray, topics.CONTROLLER_GAIN, topics.latched_qos())
-        gain_pub.publish(Float64MultiArray(data=[0.0, 0.0, 0.0, 0.0]))
+        cmd_pub = fake_controller(peer)
         events, applied = [], {}
 
         def on_joints(msg):
@@ -207,7 +214,6 @@ def test_a_parameter_request_sent_as_the_run_ends_is_answered(tmp_path):
     from rcl_interfaces.srv import SetParameters
     from rclpy.parameter import Parameter
     from sensor_msgs.msg import JointState
-    from std_msgs.msg import Float64MultiArray
 
     from ipfric_msgs.msg import VoltageCommand
     cfg = scenario_file(tmp_path, 'fig7_old_gain_exponential.yaml', sim={'duration': 0.5})
@@ -215,9 +221,7 @@ def test_a_parameter_request_sent_as_the_run_ends_is_answered(tmp_path):
     sim = None
     try:
         node = peer.node
-        cmd_pub = node.create_publisher(VoltageCommand, topics.VOLTAGE_COMMAND, topics.data_qos())
-        gain_pub = node.create_publisher(Float64MultiArray, topics.CONTROLLER_GAIN, topics.latched_qos())
-        gain_pub.publish(Float64MultiArray(data=[0.0, 0.0, 0.0, 0.0]))
+        cmd_pub = fake_controller(peer)
         client = node.create_client(SetParameters, '/sim_node/set_parameters')
         calls = []
 

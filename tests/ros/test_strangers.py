@@ -13,23 +13,16 @@ import time
 
 import numpy as np
 import pytest
-from rosrun import Peer, scenario_file
+from rosrun import run_beside_peer, scenario_file
 
 from ipfric_core.analysis.bagread import read_run
 from ipfric_core.physics.closedloop import run_closed_loop
-from ipfric_core.run.runner import EXIT_FAULT, Run
+from ipfric_core.run.runner import EXIT_FAULT
 from ipfric_core.run.scenario import load_scenario
 
 pytestmark = pytest.mark.ros
 DURATION = 8.0
 
-
-def started(log, proc, timeout=120.0):
-    t0 = time.monotonic()
-    while not (log.exists() and 'START at sample 0' in log.read_text()):
-        assert proc.poll() is None, f'{proc.args[0]} exited'
-        assert time.monotonic() - t0 < timeout, 'the run did not start'
-        time.sleep(0.05)
 
 
 def idle(peer, topics):
@@ -91,20 +84,11 @@ def bogus_joint_states(peer, topics):
 def test_a_stranger_leaves_the_rig_balanced_and_is_reported(tmp_path, stranger):
     from ipfric_ros import topics
     cfg = scenario_file(tmp_path, 'default.yaml', sim={'duration': DURATION})
-    r = Run(cfg, tmp_path / 'run', timeout=300)
-    r.start()
-    peer = None
-    try:
-        started(r.logs['sim_node'], r.procs['sim_node'])
-        peer = Peer('rogue', domain=r.domain)
+    with run_beside_peer(cfg, tmp_path / 'run', 'rogue') as (r, peer):
         tick = stranger(peer, topics)
         while r.procs['sim_node'].poll() is None:
             tick()
         res = r.wait()
-    finally:
-        if peer is not None:
-            peer.close()
-        r.kill()
     assert res.exit_code == EXIT_FAULT and res.end_reason == 'END', res.summary()
     assert any('/rogue' in f for f in res.faults), res.faults
     sim = json.loads((tmp_path / 'run' / 'sim_result.json').read_text())

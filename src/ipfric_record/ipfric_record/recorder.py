@@ -84,9 +84,9 @@ class Recorder(Node):
                                 'scenario parameter file of the run (a path or an installed scenario\'s name), stored '
                                 'in the bag metadata',
                                 read_only=True)
-        self.nice = declare(self, 'recorder', 'nice', 10,
-                            'niceness of the recorder while it records: the sample loop of the simulator and the '
-                            'controller goes first, the recorder catches up in their slack', (0, 19), read_only=True)
+        self.nice = declare(self, 'recorder', 'nice', 0,
+                            'niceness of the recorder while it records (a realtime loop at real-time priority goes '
+                            'first anyway; 10 gives way to it without the privilege)', (0, 19), read_only=True)
         check_unknown(self, 'recorder')
         self.path = Path(output or time.strftime('ipfric_%Y%m%d_%H%M%S'))
         self.custom = {}
@@ -105,7 +105,7 @@ class Recorder(Node):
             depth = 1 if latched else (100 if name == topics.SAFETY_EVENT else topics.DATA_DEPTH)
             resolved = self.resolve_topic_name(name)
             self.writer.add_topic(resolved, type_name, qos_dict(depth=depth, transient_local=latched))
-            qos = topics.latched_qos() if latched else topics.data_qos(topics.RECORD_DEPTH)
+            qos = topics.latched_qos() if latched else topics.data_qos()
             sub = self.create_subscription(cls, name, lambda _: None, qos, raw=True, callback_group=topics.OwnLoop())
             self.subs.append((sub, resolved))
         self.sub_events = next(s for s, name in self.subs if name.endswith('/' + topics.SAFETY_EVENT))
