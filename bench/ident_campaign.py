@@ -260,12 +260,12 @@ def summarize(cases: list[dict], threshold: float, meta: dict) -> dict:
     outcomes = Counter(c['outcome'] for c in cases)
     by_setting = {}
     for key in sorted({(c['experiment'], c['theta_column']) for c in cases}):
-        sel = [c for c in cases if (c['experiment'], c['theta_column']) == key]
-        floors = [c['oracle_counts']['x_rms_counts'] for c in sel
+        same = [c for c in cases if (c['experiment'], c['theta_column']) == key]
+        floors = [c['oracle_counts']['x_rms_counts'] for c in same
                   if c.get('oracle_counts') and 'x_rms_counts' in c['oracle_counts']]
         by_setting[f'{key[0]} / {key[1]}'] = dict(
-            n=len(sel), right=sum(c['outcome'] in ('correct', 'acceptable') for c in sel),
-            outcomes=dict(Counter(c['outcome'] for c in sel)),
+            n=len(same), right=sum(c['outcome'] in ('correct', 'acceptable') for c in same),
+            outcomes=dict(Counter(c['outcome'] for c in same)),
             true_model_counts_median=float(np.median(floors)) if floors else None)
     return dict(
         meta=meta, threshold_counts=threshold, n_cases=len(cases), outcomes=dict(outcomes),

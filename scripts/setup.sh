@@ -197,10 +197,10 @@ fi
 
 # ---------------------------------------------------------------- (e) colcon build of ros2_ws
 src_hash() {
-  # paths + contents of every file under src/ (build by-products excluded), plus what the
-  # build depends on outside src/: the venv's requirements and this build recipe
+  # paths + contents of every file under src/ (the symlinked config/ followed; build by-products
+  # excluded), plus what the build depends on outside src/: the venv's requirements and this recipe
   {
-    (cd "$ROOT" && find src \( -name __pycache__ -o -name '*.egg-info' -o -name .pytest_cache \) -prune \
+    (cd "$ROOT" && find -L src \( -name __pycache__ -o -name '*.egg-info' -o -name .pytest_cache \) -prune \
         -o \( -type f -o -type l \) ! -name '*.pyc' -print0 | LC_ALL=C sort -z | xargs -0 -r sha256sum)
     echo "requirements $req_hash"
     echo "python $VPY"

@@ -8,12 +8,14 @@ from __future__ import annotations
 import os
 import subprocess
 import time
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 import yaml
 
-from ipfric_core.run.runner import executable, pick_domain, ros_environment
+from ipfric_core.run.runner import Run, executable, pick_domain, ros_environment
+from ipfric_core.run.scenario import SECTION_KEYS
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = ROOT / 'config'
@@ -24,7 +26,7 @@ def scenario_file(tmp_path: Path, name: str, sim: dict | None = None, controller
     """config/<name>.yaml with entries of the two sections replaced (dotted keys nest)."""
     data = yaml.safe_load((CONFIG / name).read_text())
     for section, changes in (('sim_node', sim), ('controller_node', controller)):
-        params = data[section]['ros__parameters']
+        params = data[SECTION_KEYS[section]]['ros__parameters']
         for key, value in (changes or {}).items():
             node = params
             *path, leaf = key.split('.')
@@ -75,3 +77,29 @@ class Peer:
         self.executor.shutdown()
         self.node.destroy_node()
         self.context.try_shutdown()
+
+
+def started(log: Path, proc, timeout: float = 120.0) -> None:
+    """Until the simulator logged sample 0 (a hang guard, not a timing)."""
+    t0 = time.monotonic()
+    while not (log.exists() and 'START at sample 0' in log.read_text()):
+        assert proc.poll() is None, f'{proc.args[0]} exited: ' + (log.read_text()[-2000:] if log.exists() else '')
+        assert time.monotonic() - t0 < timeout, 'the run did not start'
+        time.sleep(0.05)
+
+
+@contextmanager
+def run_beside_peer(config, out: Path, name: str, **kwargs):
+    """A :class:`Run` of ``config`` and, once its simulator started, a :class:`Peer` ``name`` in the
+    run's domain; both ended however the block ends. Yields (run, peer)."""
+    r = Run(config, out, timeout=300, **kwargs)
+    r.start()
+    peer = None
+    try:
+        started(r.logs['sim_node'], r.procs['sim_node'])
+        peer = Peer(name, domain=r.domain)
+        yield r, peer
+    finally:
+        if peer is not None:
+            peer.close()
+        r.kill()

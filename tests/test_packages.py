@@ -191,3 +191,43 @@ def test_the_readme_maps_every_module():
         assert listed == {m.split('/')[1] for m in modules if m.startswith(f'{layer}/')}, layer
     top = {m for m in modules if '/' not in m}
     assert all(f'| `{m}` |' in text for m in top), top
+
+
+#: rosdep keys of the Python packages the ROS packages import (the ROS packages are their own keys)
+ROSDEP_KEYS = {'numpy': 'python3-numpy', 'scipy': 'python3-scipy', 'yaml': 'python3-yaml', 'numba': 'python3-numba',
+               'matplotlib': 'python3-matplotlib', 'zstandard': 'python3-zstandard', 'lz4': 'python3-lz4',
+               'control': 'python3-control-pip', 'mcap': 'python3-mcap-pip',
+               'mcap_ros2': 'python3-mcap-ros2-support-pip', 'rosbags': 'python3-rosbags-pip'}
+#: imports no package.xml declares: the checkout's bench/ (./ipfric bench) and the optional Dask extra
+UNDECLARED = {'bench', 'distributed'}
+
+
+@pytest.mark.parametrize('package', sorted(p.name for p in (ROOT / 'src').iterdir() if (p / 'package.xml').exists()))
+def test_every_package_declares_what_it_imports(package):
+    """rosdep install of a package brings every module its code imports (numba, mcap, rosbags, ...)."""
+    import xml.etree.ElementTree as ET
+    src = ROOT / 'src' / package
+    imported = set()
+    for f in src.rglob('*.py'):
+        if f.name == 'setup.py':
+            continue
+        for node in ast.walk(ast.parse(f.read_text())):
+            if isinstance(node, ast.Import):
+                imported |= {a.name.split('.')[0] for a in node.names}
+            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                imported.add(node.module.split('.')[0])
+    imported -= set(sys.stdlib_module_names) | {'__future__', package} | UNDECLARED
+    declared = {e.text for e in ET.parse(src / 'package.xml').getroot()
+                if e.tag in ('depend', 'exec_depend', 'build_export_depend')}
+    missing = sorted(ROSDEP_KEYS.get(m, m) for m in imported if ROSDEP_KEYS.get(m, m) not in declared)
+    assert not missing, f'{package}/package.xml does not declare {missing}'
+
+
+def test_every_safety_event_code_has_its_constant():
+    """SafetyEvent.msg has a constant for each code sim_node publishes, and none it never publishes."""
+    from ipfric_core.constants import EVENT_CODES
+    msg = (ROOT / 'src' / 'ipfric_msgs' / 'msg' / 'SafetyEvent.msg').read_text()
+    assert sorted(re.findall(r'^string ([A-Z_]+)="\1"$', msg, re.M)) == sorted(EVENT_CODES)
+    sim = '\n'.join(p.read_text() for p in (ROOT / 'src' / 'ipfric_sim' / 'ipfric_sim').glob('*.py'))
+    used = set(re.findall(r'SafetyEvent\.([A-Z_]+)', sim)) | set(re.findall(r"^([A-Z_]+) = '\1'$", sim, re.M))
+    assert used <= set(EVENT_CODES) and {'STALL', 'INTRUDER', 'BAD_COMMAND', 'WATCHDOG'} <= used

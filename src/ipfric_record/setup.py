@@ -10,7 +10,7 @@ setup(
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
         ('share/' + package_name, ['package.xml']),
     ],
-    install_requires=['setuptools'],
+    install_requires=['setuptools', 'mcap', 'rosbags', 'pyyaml'],
     zip_safe=True,
     maintainer='ipfric maintainers',
     maintainer_email='maintainers@ipfric.org',

@@ -135,7 +135,7 @@ def test_scenario_errors_name_the_field(sim, ctrl, words):
 def test_scenario_file_sections(tmp_path):
     p = tmp_path / 's.yaml'
     p.write_text('sim_node:\n  ros__parameters: {}\n')
-    with pytest.raises(ConfigError, match='missing section controller_node'):
+    with pytest.raises(ConfigError, match='no section for controller_node'):
         load_scenario(p)
 
 

@@ -86,10 +86,12 @@ def test_lockstep_equals_offline_closed_loop(runs):
 def test_recorded_counts_equal_published_counts(runs):
     res, bag = runs('fig7_old_gain_exponential')
     n = res.samples
-    assert res.published == {'/clock': n, 'joint_states': n, 'plant_state': n, 'safety_event': 2}
+    diagnostics = (n - 1) // 1000                         # one per second of simulated time
+    assert res.published == {'/clock': n, '/joint_states': n, '/plant_state': n, '/safety_event': 2,
+                             '/diagnostics': diagnostics}
     assert res.counts_match
     assert bag.counts == {'/clock': n, '/joint_states': n, '/plant_state': n, '/voltage_command': n,
-                          '/safety_event': 2, '/controller_gain': 1}
+                          '/safety_event': 2, '/controller_gain': 1, '/diagnostics': diagnostics}
     # the controller's own count (logged at its shutdown) equals the recorded commands
     log = (res.out and open(f'{res.out}/logs/controller_node.log').read())
     assert f'published {n} commands' in log
@@ -144,7 +146,7 @@ def test_realtime_mode_is_paced_by_the_wall_clock(tmp_path):
 @pytest.mark.parametrize('name', sorted(p.name for p in CONFIG.glob('*.yaml') if p.name != 'paper.yaml'))
 def test_scenario_files_load(name):
     scn = load_scenario(CONFIG / name)
-    assert scn.sim.time_mode == 'lockstep' and len(scn.gain()) == 4
+    assert scn.sim.time_mode == ('realtime' if name == 'realtime.yaml' else 'lockstep') and len(scn.gain()) == 4
 
 
 def test_analyze_finds_the_figure_7_cycle_in_the_bag(runs, tmp_path):

@@ -6,20 +6,11 @@ import sys
 import time
 
 import pytest
-from rosrun import scenario_file, start_node
+from rosrun import scenario_file, start_node, started
 
 from ipfric_core.analysis.bagread import read_run
 from ipfric_core.constants import REPO_ROOT as ROOT
 from ipfric_core.run.runner import Run, pick_domain
-
-
-def wait_for_start(log, proc, timeout=60.0):
-    """Until the simulator logged sample 0 (the peers are matched)."""
-    t0 = time.monotonic()
-    while not (log.exists() and 'START at sample 0' in log.read_text()):
-        assert proc.poll() is None, f'{proc.args[0]} exited: ' + (log.read_text() if log.exists() else '')
-        assert time.monotonic() - t0 < timeout, 'the run did not start'
-        time.sleep(0.05)
 
 
 @pytest.mark.parametrize('node, changes, field', [
@@ -66,7 +57,7 @@ def test_killed_controller_trips_the_watchdog_and_fails_the_run(tmp_path):
     r = Run(cfg, tmp_path / 'run', duration=20.0, timeout=120, grace=30.0)
     r.start()
     try:
-        wait_for_start(r.logs['sim_node'], r.procs['sim_node'])
+        started(r.logs['sim_node'], r.procs['sim_node'])
         time.sleep(0.3)                   # mid-run (not a discovery wait)
         r.procs['controller_node'].kill()  # SIGKILL: no goodbye to the DDS graph
         res = r.wait()
@@ -94,7 +85,7 @@ def test_ctrl_c_stops_the_run_and_keeps_a_readable_bag(tmp_path):
                           str(ROOT / 'config' / 'default.yaml'), '--duration', '0', '--out', str(out),
                           '--json'], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT)
     try:
-        wait_for_start(out / 'logs' / 'sim_node.log', p)
+        started(out / 'logs' / 'sim_node.log', p)
         time.sleep(0.5)                   # let it run a little
         p.send_signal(signal.SIGINT)      # Ctrl-C reaches the runner only (nodes have their own session)
         stdout, stderr = p.communicate(timeout=60)

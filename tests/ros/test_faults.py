@@ -6,15 +6,13 @@ documented exit code (runner.py: 1 a node failed, 3 a safety fault, 130 stopped)
 bag that ``read_run`` reads, its loss stated. Bounds on waits only guard against a hang.
 """
 import json
-import math
 import signal
 import subprocess
 import sys
 import time
-from pathlib import Path
 
 import pytest
-from rosrun import Peer, scenario_file
+from rosrun import scenario_file, started
 
 from ipfric_core.analysis.bagread import read_run
 from ipfric_core.constants import REPO_ROOT as ROOT
@@ -23,14 +21,6 @@ from ipfric_core.run.runner import EXIT_FAULT, Run
 pytestmark = pytest.mark.ros
 CFG = ROOT / 'config' / 'default.yaml'
 
-
-def started(log, proc, timeout=90.0):
-    """Until the simulator logged sample 0 (a hang guard, not a timing)."""
-    t0 = time.monotonic()
-    while not (log.exists() and 'START at sample 0' in log.read_text()):
-        assert proc.poll() is None, f'{proc.args[0]} exited'
-        assert time.monotonic() - t0 < timeout, 'the run did not start'
-        time.sleep(0.05)
 
 
 def processes_of(out) -> list[str]:
@@ -128,67 +118,3 @@ def test_a_paused_controller_is_a_stall_event_and_a_fault(tmp_path):
     codes = [code for _, code, _ in bag.events]
     assert codes.count('STALL') == 1 and 'WATCHDOG' in codes
     assert bag.intact
-
-
-def run_with_rogue(tmp_path, duration: float, name: str, msg_type, topic: str, send, pause: float):
-    """A run of ``duration`` simulated s with a second process that, from the simulator's start
-    to its end, calls ``send(publisher)`` every ``pause`` s on ``topic``; the run's result."""
-    from ipfric_ros import topics
-    cfg = scenario_file(tmp_path, 'default.yaml', sim={'duration': duration})
-    r = Run(cfg, tmp_path / 'run', timeout=300)
-    r.start()
-    peer = None
-    try:
-        started(r.logs['sim_node'], r.procs['sim_node'])
-        peer = Peer(name, domain=r.domain)
-        pub = peer.node.create_publisher(msg_type, topic, topics.data_qos())
-        while r.procs['sim_node'].poll() is None:
-            send(pub)
-            time.sleep(pause)
-        return r, r.wait()
-    finally:
-        if peer is not None:
-            peer.close()
-        r.kill()
-
-
-def test_a_rogue_flood_is_refused_counted_and_cannot_hold_the_simulator(tmp_path):
-    from rclpy._rclpy_pybind11 import RCLError
-
-    from ipfric_msgs.msg import VoltageCommand
-    from ipfric_ros import topics
-    sent = 0
-
-    def flood(pub):                                 # NaN, inf, 1e6 V for a sample far ahead, ~5 kHz
-        nonlocal sent
-        for v in (math.nan, math.inf, -1e6):
-            try:
-                pub.publish(VoltageCommand(voltage=v, sample_index=10 ** 6 + sent))
-                sent += 1
-            except RCLError:                        # the writer's queue full: the flood goes on
-                pass
-    # long enough that discovery (seconds on loopback) meets the rogue while the run goes on
-    _, res = run_with_rogue(tmp_path, 12.0, 'rogue', VoltageCommand, topics.VOLTAGE_COMMAND, flood, 5e-4)
-    assert sent > 1000
-    assert res.exit_code == EXIT_FAULT, res.summary()
-    assert res.end_reason == 'END'                 # the simulator reached its duration
-    sim = json.loads((tmp_path / 'run' / 'sim_result.json').read_text())
-    assert sim['refused_by_kind'].get('unexpected publisher', 0) > 100
-    assert sim['intruders'] == {topics.VOLTAGE_COMMAND: 1}
-    bag = read_run(res.bag)
-    codes = [code for _, code, _ in bag.events]
-    assert 'INTRUDER' in codes
-    assert codes.count('BAD_COMMAND') <= 2 + 12 * 2  # per burst (about one a second), not per message
-
-
-def test_fake_measurements_from_a_second_publisher_are_refused_by_the_controller(tmp_path):
-    """A second writer on joint_states: the controller takes no measurement while it is there
-    (no command from fake positions), says so, and the run ends with a fault."""
-    from sensor_msgs.msg import JointState
-
-    from ipfric_ros import topics
-    fake = JointState(name=list(topics.JOINT_NAMES), position=[0.0, 0.4])   # a "fallen" angle
-    r, res = run_with_rogue(tmp_path, 8.0, 'fake_encoders', JointState, topics.JOINT_STATES,
-                            lambda pub: pub.publish(fake), 1e-3)
-    assert res.exit_code != 0, res.summary()     # 3 when the simulator caught the writer, else 1 (counts)
-    assert 'measurements refused' in Path(r.logs['controller_node']).read_text()

@@ -54,9 +54,18 @@ def test_a_burst_of_refusals_gives_two_events_with_counts():
     assert g.refused == 5000
 
 
+def fake_controller(peer):
+    """The peer as the simulator's controller: its gain announced (latched); its command publisher."""
+    from std_msgs.msg import Float64MultiArray
+
+    from ipfric_msgs.msg import VoltageCommand
+    gain_pub = peer.node.create_publisher(Float64MultiArray, topics.CONTROLLER_GAIN, topics.latched_qos())
+    gain_pub.publish(Float64MultiArray(data=[0.0, 0.0, 0.0, 0.0]))
+    return peer.node.create_publisher(VoltageCommand, topics.VOLTAGE_COMMAND, topics.data_qos())
+
+
 def test_sim_refuses_nan_inf_and_out_of_range_commands(tmp_path):
     from sensor_msgs.msg import JointState
-    from std_msgs.msg import Float64MultiArray
 
     from ipfric_msgs.msg import PlantState, SafetyEvent, VoltageCommand
     bad = {10: math.nan, 20: math.inf, 30: 25.0}
@@ -65,9 +74,7 @@ def test_sim_refuses_nan_inf_and_out_of_range_commands(tmp_path):
     sim = None
     try:
         node = peer.node
-        cmd_pub = node.create_publisher(VoltageCommand, topics.VOLTAGE_COMMAND, topics.data_qos())
-        gain_pub = node.create_publisher(Float64MultiArray, topics.CONTROLLER_GAIN, topics.latched_qos())
-        gain_pub.publish(Float64MultiArray(data=[0.0, 0.0, 0.0, 0.0]))
+        cmd_pub = fake_controller(peer)
         events, applied = [], {}
 
         def on_joints(msg):
@@ -80,7 +87,8 @@ def test_sim_refuses_nan_inf_and_out_of_range_commands(tmp_path):
                                  lambda m: applied.__setitem__(m.sample_index, m.voltage_applied),
                                  topics.data_qos())
         sim = start_node('sim_node', ['--params-file', str(cfg), '-p', 'start_timeout_s:=20.0',
-                                      '-p', f'result_file:={tmp_path / "result.json"}'],
+                                      '-p', f'result_file:={tmp_path / "result.json"}',
+                                      '-p', 'wait_for_recorder:=false', '-p', 'controller_node:=/fake_controller'],
                          peer.domain, tmp_path / 'sim.log')
         peer.spin_until(lambda: any(e.code == 'END' for e in events), 60, 'the END event')
         assert sim.wait(timeout=30) == 0
@@ -123,7 +131,8 @@ def test_controller_skips_nan_measurements_and_validates_parameters(tmp_path):
                                  lambda m: cmds.__setitem__(m.sample_index, m), topics.data_qos())
         node.create_subscription(Float64MultiArray, topics.CONTROLLER_GAIN,
                                  lambda m: gains.append(list(m.data)), topics.latched_qos())
-        ctl = start_node('controller_node', ['--params-file', str(cfg), '-p', 'use_sim_time:=true'],
+        ctl = start_node('controller_node', ['--params-file', str(cfg), '-p', 'use_sim_time:=true',
+                                             '-p', 'rig_node:=/fake_sim', '-p', 'min_command_subscribers:=1'],
                          peer.domain, tmp_path / 'controller.log')
         peer.spin_until(lambda: gains and js_pub.get_subscription_count() >= 1, 60, 'the controller')
         assert gains[0] == [70.7107, 304.9273, 143.3152, 61.0833]
@@ -185,7 +194,10 @@ def test_controller_designs_the_gain_at_start_up(tmp_path):
         # the controller announces itself once a command subscription exists
         from ipfric_msgs.msg import VoltageCommand
         peer.node.create_subscription(VoltageCommand, topics.VOLTAGE_COMMAND, lambda m: None, topics.data_qos())
-        ctl = start_node('controller_node', ['--params-file', str(cfg)], peer.domain, tmp_path / 'ctl.log')
+        from sensor_msgs.msg import JointState
+        peer.node.create_publisher(JointState, topics.JOINT_STATES, topics.data_qos())   # the rig, as the controller
+        ctl = start_node('controller_node', ['--params-file', str(cfg), '-p', 'rig_node:=/gain_listener',
+                                             '-p', 'min_command_subscribers:=1'], peer.domain, tmp_path / 'ctl.log')
         peer.spin_until(lambda: gains, 60, 'controller_gain')
     finally:
         peer.close()
@@ -194,3 +206,41 @@ def test_controller_designs_the_gain_at_start_up(tmp_path):
             assert ctl.wait(timeout=30) == 0
     assert gains[0] == pytest.approx([70.7107, 304.9273, 143.3152, 61.0833], rel=1e-4)
     assert 'designed by LQR on the exponential friction model' in (tmp_path / 'ctl.log').read_text()
+
+
+def test_a_parameter_request_sent_as_the_run_ends_is_answered(tmp_path):
+    """`ros2 param set /sim_node ...` sent in the last samples of a run: the simulator answers it (a
+    refusal, its parameters are read-only) before its services go, instead of leaving the caller hanging."""
+    from rcl_interfaces.srv import SetParameters
+    from rclpy.parameter import Parameter
+    from sensor_msgs.msg import JointState
+
+    from ipfric_msgs.msg import VoltageCommand
+    cfg = scenario_file(tmp_path, 'fig7_old_gain_exponential.yaml', sim={'duration': 0.5})
+    peer = Peer('fake_controller')
+    sim = None
+    try:
+        node = peer.node
+        cmd_pub = fake_controller(peer)
+        client = node.create_client(SetParameters, '/sim_node/set_parameters')
+        calls = []
+
+        def on_joints(msg):
+            k = round(topics.stamp_to_ns(msg.header.stamp) / 1e6)
+            if k == 450:                                 # 50 samples before the end
+                req = SetParameters.Request(parameters=[Parameter('theta0', value=0.1).to_parameter_msg()])
+                calls.append(client.call_async(req))
+            cmd_pub.publish(VoltageCommand(voltage=0.0, measurement_stamp=msg.header.stamp, sample_index=k))
+        node.create_subscription(JointState, topics.JOINT_STATES, on_joints, topics.data_qos())
+        sim = start_node('sim_node', ['--params-file', str(cfg), '-p', 'wait_for_recorder:=false',
+                                      '-p', 'controller_node:=/fake_controller'], peer.domain, tmp_path / 'sim.log')
+        peer.spin_until(client.service_is_ready, 60, 'the parameter service')
+        peer.spin_until(lambda: calls and calls[0].done(), 30, 'the answer to a request sent as the run ends')
+        assert sim.wait(timeout=30) == 0
+    finally:
+        peer.close()
+        if sim is not None and sim.poll() is None:
+            sim.kill()
+            sim.wait()
+    answer = calls[0].result().results[0]
+    assert not answer.successful and 'read-only' in answer.reason

@@ -12,16 +12,20 @@ import math
 import os
 from pathlib import Path
 
-__all__ = ['REPO_ROOT', 'CLOCK', 'JOINT_STATES', 'PLANT_STATE', 'VOLTAGE_COMMAND', 'SAFETY_EVENT', 'CONTROLLER_GAIN',
-           'JOINT_NAMES', 'DURATION', 'FALLEN', 'TRACK_LIMIT', 'START', 'END', 'ABORT', 'LIMITS', 'TERMINAL_EVENTS',
-           'ANGLE_RESOLUTION_RAD', 'CART_RESOLUTION_M', 'TRACK_LIMIT_M', 'FALLEN_ANGLE_RAD']
+__all__ = ['REPO_ROOT', 'CLOCK', 'DIAGNOSTICS', 'PARAMETER_EVENTS', 'JOINT_STATES', 'PLANT_STATE', 'VOLTAGE_COMMAND',
+           'SAFETY_EVENT', 'CONTROLLER_GAIN', 'JOINT_NAMES', 'DURATION', 'FALLEN', 'TRACK_LIMIT', 'START', 'END',
+           'ABORT', 'LIMITS', 'TERMINAL_EVENTS', 'EVENT_CODES', 'ANGLE_RESOLUTION_RAD', 'CART_RESOLUTION_M',
+           'TRACK_LIMIT_M', 'FALLEN_ANGLE_RAD']
 
 #: the checkout (or the workspace's symlinked source tree) ipfric runs from: its config/, runs/, ros2_ws/;
 #: IPFRIC_ROOT overrides it
 REPO_ROOT = Path(os.environ.get('IPFRIC_ROOT') or Path(__file__).resolve().parents[3])
 
-# -- topics of a run (``/clock`` is global, the others are relative to the node's namespace)
-CLOCK = '/clock'
+# -- topics of a run, relative to the rig's namespace (``/rig1/joint_states``; at the root the usual
+# ``/joint_states``, ``/clock``): each rig has its own clock, which every node of the rig follows
+CLOCK = 'clock'
+DIAGNOSTICS = 'diagnostics'
+PARAMETER_EVENTS = '/parameter_events'
 JOINT_STATES = 'joint_states'
 PLANT_STATE = 'plant_state'
 VOLTAGE_COMMAND = 'voltage_command'
@@ -41,6 +45,8 @@ ABORT = 'ABORT'              # ROS run: stopped from outside or by an error
 LIMITS = (FALLEN, TRACK_LIMIT)
 #: SafetyEvent codes that end a ROS run
 TERMINAL_EVENTS = (END, TRACK_LIMIT, FALLEN, ABORT)
+#: every SafetyEvent code sim_node publishes (ipfric_msgs/msg/SafetyEvent.msg has a constant for each)
+EVENT_CODES = (START, *TERMINAL_EVENTS, 'BAD_COMMAND', 'WATCHDOG', 'STALL', 'INTRUDER')
 
 # -- the paper's rig (section 6) and its safety limits
 ANGLE_RESOLUTION_RAD = math.radians(0.08789)   # angle encoder count, 4096 counts/rev [rad]

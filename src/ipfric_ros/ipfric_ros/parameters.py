@@ -20,6 +20,8 @@ from ipfric_core.run.scenario import Scenario, nest, scenario_from_ros_params
 
 from .rclpy_internals import parameter_overrides
 
+__all__ = ['plain', 'descriptor', 'coerced', 'as_declared', 'declare', 'check_unknown', 'declare_scenario']
+
 _TYPES = {bool: ParameterType.PARAMETER_BOOL, int: ParameterType.PARAMETER_INTEGER,
           float: ParameterType.PARAMETER_DOUBLE, str: ParameterType.PARAMETER_STRING}
 
@@ -54,17 +56,34 @@ def descriptor(name: str, default, description: str, rng=None, read_only: bool =
     return d
 
 
+def _integral(v) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool)
+
+
+def coerced(param: Parameter, ptype: int) -> Parameter:
+    """``param`` as a double (array) where one is declared and integers were given (``duration: 5``,
+    ``ros2 param set ... delay 0``); any other parameter unchanged."""
+    value = param.value
+    if ptype == ParameterType.PARAMETER_DOUBLE and _integral(value):
+        return Parameter(param.name, Parameter.Type.DOUBLE, float(value))
+    if (ptype == ParameterType.PARAMETER_DOUBLE_ARRAY and isinstance(value, (list, array.array))
+            and all(_integral(v) or isinstance(v, float) for v in value)):
+        return Parameter(param.name, Parameter.Type.DOUBLE_ARRAY, [float(v) for v in value])
+    return param
+
+
+def as_declared(node, param: Parameter) -> Parameter:
+    """A pre-set parameters callback's conversion: ``param`` in the type ``node`` declared it with."""
+    if not node.has_parameter(param.name):
+        return param
+    return coerced(param, node.describe_parameter(param.name).type)
+
+
 def _coerce_override(node, name: str, ptype: int) -> None:
-    """Accept an integer in the parameter file where a double is declared (``duration: 5``)."""
+    """Accept integers in the parameter file where a double (array) is declared."""
     overrides = parameter_overrides(node)
-    if not overrides or name not in overrides:
-        return
-    value = overrides[name].value
-    if ptype == ParameterType.PARAMETER_DOUBLE and isinstance(value, int) and not isinstance(value, bool):
-        overrides[name] = Parameter(name, Parameter.Type.DOUBLE, float(value))
-    elif (ptype == ParameterType.PARAMETER_DOUBLE_ARRAY and isinstance(value, (list, array.array))
-          and all(isinstance(v, int) and not isinstance(v, bool) for v in value)):
-        overrides[name] = Parameter(name, Parameter.Type.DOUBLE_ARRAY, [float(v) for v in value])
+    if overrides and name in overrides:
+        overrides[name] = coerced(overrides[name], ptype)
 
 
 def declare(node, section: str, name: str, default, description: str, rng=None,
@@ -100,12 +119,30 @@ def check_unknown(node, section: str) -> None:
     raise ConfigError(f'{section}.ros__parameters: unknown parameter(s) {", ".join(hints)}')
 
 
+#: What a node's section must give (as a scenario file must): a friction model for the simulator,
+#: a gain (or a friction model to design it on) for the controller.
+REQUIRED = {'sim_node': ('friction.model',), 'controller_node': ('gain', 'design_friction.model')}
+
+
+def _check_given(node, section: str) -> None:
+    """Refuse to run on schema defaults: a node whose parameter file has no section for it (e.g.
+    ``sim_node:`` when the node runs in a namespace) would otherwise run a scenario nobody wrote."""
+    given = parameter_overrides(node) or {}
+    if not any(name in given for name in REQUIRED[section]):
+        fqn = node.get_fully_qualified_name()
+        raise ConfigError(
+            f'{section}.ros__parameters: no scenario parameters for node {fqn} (none of '
+            f'{", ".join(REQUIRED[section])}): give a parameter file with a section that matches the node, e.g. '
+            f'"/**/{section}:" (any namespace; "{section}:" matches only /{section}), as config/*.yaml have')
+
+
 def declare_scenario(node, section: str, read_only=True) -> Scenario:
     """Declare the parameters of ``section`` on ``node`` and return the validated Scenario.
 
     ``read_only``: True (all), or a collection of names that cannot change at run time.
     """
     defaults = Scenario.flat_defaults(section)
+    _check_given(node, section)
     values = {}
     for name, (default, doc, rng) in defaults.items():
         ro = read_only is True or (read_only is not False and name in read_only)

@@ -18,6 +18,9 @@ from __future__ import annotations
 
 from importlib.metadata import PackageNotFoundError, version
 
+__all__ = ['RCLPY_SERIES', 'rclpy_version', 'check_version', 'SubscriptionWaiter', 'publisher_gid',
+           'parameter_overrides']
+
 #: The rclpy release line the internals below were checked with (major, minor).
 RCLPY_SERIES = (9, 1)
 
@@ -43,20 +46,27 @@ def check_version(found: str | None = None) -> None:
 
 
 class SubscriptionWaiter:
-    """Wait on some subscriptions alone and take what they hold (with the publisher's GID)."""
+    """Wait on some subscriptions (and services) alone and take what the subscriptions hold (with
+    the publisher's GID); the services are left to an executor turn when :meth:`wait` says one
+    has a request."""
 
-    def __init__(self, node, *subscriptions):
+    def __init__(self, node, *subscriptions, services=()):
         from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
         self.subscriptions = subscriptions
-        self.wait_set = _rclpy.WaitSet(len(subscriptions), 0, 0, 0, 0, 0, node.context.handle)
+        self.services = tuple(services)
+        self.wait_set = _rclpy.WaitSet(len(subscriptions), 0, 0, 0, len(self.services), 0, node.context.handle)
 
-    def wait(self, timeout_s: float) -> None:
-        """Return when a message is there or after ``timeout_s`` [s]."""
+    def wait(self, timeout_s: float) -> bool:
+        """Return when a message or a request is there or after ``timeout_s`` [s]; whether a
+        service has a request."""
         ws = self.wait_set
         ws.clear_entities()
         for sub in self.subscriptions:
             ws.add_subscription(sub.handle)
+        for srv in self.services:
+            ws.add_service(srv.handle)
         ws.wait(int(timeout_s * 1e9))
+        return bool(self.services) and bool(ws.get_ready_entities('service'))
 
     def take(self, i: int = 0):
         """(message, publisher GID as bytes) from subscription ``i``, or None when nothing is queued

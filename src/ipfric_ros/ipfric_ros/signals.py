@@ -20,17 +20,22 @@ import signal
 import threading
 import time
 from contextlib import contextmanager
+from pathlib import Path
 
 from ipfric_core.run.runner import SUPERVISED, die_with_parent
 
 LINGER_S = 1.0    # [s] the recorder's wait after the supervisor died, for the others' last messages
 
 
+__all__ = ['FASTDDS_PROFILE', 'LINGER_S', 'StopRequest', 'NodeProcess', 'node_process']
+
+
 class StopRequest:
-    """Set by SIGINT or SIGTERM; ``reason`` names the signal."""
+    """Set by SIGINT, SIGTERM or SIGHUP; ``reason`` names the first, ``count`` counts the signals."""
 
     def __init__(self):
         self.reason: str | None = None
+        self.count = 0
 
     def __bool__(self) -> bool:
         return self.reason is not None
@@ -41,6 +46,7 @@ class StopRequest:
 
     def install(self) -> StopRequest:
         def handler(signum, _frame):
+            self.count += 1
             self.request(signal.Signals(signum).name)
         for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
             signal.signal(sig, handler)
@@ -84,15 +90,22 @@ class NodeProcess:
         return node
 
 
+#: The Fast DDS profile of the nodes (fastdds.xml: reliable writers' heartbeat every 20 ms).
+FASTDDS_PROFILE = Path(__file__).with_name('fastdds.xml')
+
+
 @contextmanager
 def node_process(name: str, args=None):
-    """rclpy initialised without its signal handlers (see above); at exit every node added
-    is destroyed and rclpy shut down, whatever happened."""
+    """rclpy initialised without its signal handlers (see above) and with the nodes' Fast DDS
+    profile (unless the environment names one); at exit every node added is destroyed and rclpy
+    shut down, whatever happened."""
     import rclpy
     from rclpy.signals import SignalHandlerOptions
 
     from .rclpy_internals import check_version
     check_version()
+    if not (os.environ.get('FASTDDS_DEFAULT_PROFILES_FILE') or os.environ.get('FASTRTPS_DEFAULT_PROFILES_FILE')):
+        os.environ['FASTDDS_DEFAULT_PROFILES_FILE'] = str(FASTDDS_PROFILE)
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     proc = NodeProcess(name)
     try:

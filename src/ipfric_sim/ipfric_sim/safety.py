@@ -15,6 +15,8 @@ from __future__ import annotations
 import math
 from collections import Counter
 
+import numpy as np
+
 BAD_COMMAND = 'BAD_COMMAND'
 WATCHDOG = 'WATCHDOG'
 WATCHDOG_WALL_S = 1.0     # [s] wall time without a valid command that trips the watchdog (lockstep)
@@ -32,6 +34,14 @@ def check_command(voltage, voltage_max: float) -> str | None:
     if abs(voltage) > voltage_max:
         return f'|V| = {abs(voltage):g} V exceeds voltage_max = {voltage_max:g} V'
     return None
+
+
+def latency_summary(lat: np.ndarray) -> dict:
+    """Command latencies [s] as the run's result and the diagnostics report them: count, median, p99, max."""
+    if not len(lat):
+        return {'commands': 0}
+    return {'commands': int(len(lat)), 'median': float(np.median(lat)), 'p99': float(np.percentile(lat, 99)),
+            'max': float(lat.max())}
 
 
 def reason_kind(reason: str) -> str:

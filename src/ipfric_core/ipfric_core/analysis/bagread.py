@@ -2,7 +2,8 @@
 
 Accepts a rosbag2 directory (metadata.yaml + ``bag_0.mcap``, or ``bag.mcap`` of older runs) or a
 bare .mcap file; topics match with or without the leading ``/`` and are counted under their
-fully qualified names. The file is
+fully qualified names. A rig recorded in a namespace (``/rig1/joint_states``) is read as one at
+the root; a bag with several rigs is read for the one named (``namespace``). The file is
 memory-mapped and walked record by record; every length is checked against the end of its
 record, chunk and file before it is followed (in the compiled scanner too).
 
@@ -19,6 +20,12 @@ record, chunk and file before it is followed (in the compiled scanner too).
   (bounds in ``ABSURD``) are dropped and reported.
 - A file that is not MCAP (no magic: random bytes, empty, a CSV) is refused
   (:class:`ConfigError`, exit code 2 of the commands).
+- An intact file can still hold an incomplete run (``RunData.incomplete``): no terminal event
+  (the recording stopped before the run ended), or fewer messages than the simulator's last
+  event says it published. joint_states stamps that repeat (a second publisher on the rig's
+  topics, another run in the domain) are reported as damage.
+- ``/parameter_events`` of the rig's nodes give the run-time parameter changes
+  (``RunData.parameter_changes``: simulated time, node, parameter, value).
 
 The sample-rate topics (joint_states, voltage_command, plant_state) are taken from their
 little-endian CDR by a compiled scanner (about 0.1 us a message instead of 15 us through a
@@ -44,7 +51,15 @@ from mcap.opcode import Opcode
 from mcap.records import Channel, Footer, Message, Metadata, Schema, Statistics
 from mcap_ros2.decoder import DecoderFactory
 
-from ..constants import CONTROLLER_GAIN, JOINT_STATES, PLANT_STATE, SAFETY_EVENT, VOLTAGE_COMMAND
+from ..constants import (
+    CONTROLLER_GAIN,
+    JOINT_STATES,
+    PARAMETER_EVENTS,
+    PLANT_STATE,
+    SAFETY_EVENT,
+    TERMINAL_EVENTS,
+    VOLTAGE_COMMAND,
+)
 from ..physics.compiled import compiled
 from ..physics.params import ConfigError
 
@@ -74,6 +89,10 @@ class RunData:
     truncated: bool = False
     truncation_detail: str = ''
     damage: list = field(default_factory=list)
+    namespace: str = '/'
+    parameter_changes: list = field(default_factory=list)   # (t, node, name, value)
+    recording: dict | None = None                            # how the recorder ended (metadata)
+    incomplete: str = ''                                     # why the run in the bag is not whole
 
     @property
     def intact(self) -> bool:
@@ -82,7 +101,7 @@ class RunData:
     @property
     def end_reason(self) -> str | None:
         for _, code, _ in reversed(self.events):
-            if code in ('END', 'TRACK_LIMIT', 'FALLEN', 'ABORT'):
+            if code in TERMINAL_EVENTS:
                 return code
         return None
 
@@ -119,7 +138,7 @@ RESYNC = re.compile(rb'[\x06\x0c\x0f]')        # chunk, metadata, data end: wher
 MAX_CHUNK = 1 << 30            # largest uncompressed chunk accepted [bytes]
 SKIP, JOINTS, COMMAND, TRUTH, PYTHON = 0, 1, 2, 3, 4
 SCANNED = {JOINT_STATES: JOINTS, VOLTAGE_COMMAND: COMMAND, PLANT_STATE: TRUTH}
-DECODED = (SAFETY_EVENT, CONTROLLER_GAIN)
+DECODED = (SAFETY_EVENT, CONTROLLER_GAIN, PARAMETER_EVENTS.lstrip('/'))
 # scanner status
 END, RECORD, FULL, CUT, BAD = 0, 1, 2, 3, 4
 
@@ -251,17 +270,24 @@ def _count_messages(b):
 class _Reader:
     """Walks one memory-mapped MCAP file; ``damage`` collects what could not be read."""
 
-    def __init__(self, keep, buf):
+    def __init__(self, keep, buf, namespace: str | None = None):
         self.keep = keep
         self.buf = buf
-        self.schemas, self.channels, self.decoders = {}, {}, {}
+        self.namespace = namespace      # the rig read (None: the first whose joint_states appear)
+        self.rigs: set[str] = set()     # namespaces with joint_states in the bag
+        self.parameter_events: list = []
+        self.schemas: dict = {}
+        self.channels: dict = {}
+        self.decoders: dict = {}
         self.factory = DecoderFactory()
         self.kinds = np.zeros(65536, np.int8)
         self.counts = np.zeros(65536, np.int64)
         self.n = np.zeros(3, np.int64)
         self.out = [np.empty((4096, 3)), np.empty((4096, 2)), np.empty((4096, 1 + len(TRUTH_FIELDS)))]
-        self.events, self.gain, self.metadata = [], None, {}
-        self.damage = []            # (sentence, joint_states index where samples are missing or None)
+        self.events: list = []
+        self.gain: list | None = None
+        self.metadata: dict = {}
+        self.damage: list = []      # (sentence, joint_states index where samples are missing or None)
         self.bad_messages = 0       # messages that did not decode or fit in their record
 
     # ------------------------------------------------------------------ records
@@ -282,9 +308,14 @@ class _Reader:
 
     def channel(self, rec: Channel) -> None:
         self.channels[rec.id] = rec
-        topic = rec.topic.lstrip('/')
+        namespace, topic = _split(rec.topic)
+        if topic == JOINT_STATES:
+            self.rigs.add(namespace)
+            if self.namespace is None:
+                self.namespace = namespace
         kind = SCANNED.get(topic, PYTHON if topic in DECODED else SKIP)
-        self.kinds[rec.id] = kind if kind != SKIP and (topic in self.keep or kind == PYTHON) else SKIP
+        mine = namespace == self.namespace or topic == PARAMETER_EVENTS.lstrip('/')
+        self.kinds[rec.id] = kind if mine and kind != SKIP and (topic in self.keep or kind == PYTHON) else SKIP
 
     def message(self, rec: Message) -> None:
         ch = self.channels.get(rec.channel_id)
@@ -294,8 +325,10 @@ class _Reader:
         self.counts[ch.id] += 1
         if ch.id not in self.decoders:
             self.decoders[ch.id] = self.factory.decoder_for(ch.message_encoding, self.schemas.get(ch.schema_id))
+        namespace, topic = _split(ch.topic)
+        if namespace != self.namespace and topic != PARAMETER_EVENTS.lstrip('/'):
+            return
         m = self.decoders[ch.id](rec.data)
-        topic = ch.topic.lstrip('/')
         row: tuple | None = None
         if topic == JOINT_STATES:
             row, kind = (_stamp(m.header.stamp), m.position[0], m.position[1]), JOINTS
@@ -307,6 +340,10 @@ class _Reader:
             self.events.append((_stamp(m.header.stamp), m.code, m.detail))
         elif topic == CONTROLLER_GAIN:
             self.gain = list(m.data)
+        elif topic == PARAMETER_EVENTS.lstrip('/'):
+            for changed, params in ((False, m.new_parameters), (True, m.changed_parameters)):
+                self.parameter_events += [(_stamp(m.stamp), m.node, p.name, _parameter_value(p.value), changed)
+                                          for p in params]
         if row is not None and topic in self.keep:
             self._grow(kind - 1)
             self.out[kind - 1][self.n[kind - 1]] = row
@@ -491,13 +528,30 @@ class _Reader:
         return counts
 
 
-def read_run(path: str | Path, keep=tuple(SCANNED)) -> RunData:
+def _split(topic: str) -> tuple[str, str]:
+    """('/rig1', 'joint_states') of '/rig1/joint_states'; ('/', 'joint_states') of '/joint_states' or 'joint_states'."""
+    namespace, _, name = ('/' + topic.lstrip('/')).rpartition('/')
+    return namespace or '/', name
+
+
+def _parameter_value(v):
+    """The value of an rcl_interfaces/ParameterValue (decoded from the bag) as plain Python."""
+    field_of = {1: 'bool_value', 2: 'integer_value', 3: 'double_value', 4: 'string_value', 5: 'byte_array_value',
+                6: 'bool_array_value', 7: 'integer_array_value', 8: 'double_array_value', 9: 'string_array_value'}
+    name = field_of.get(v.type)
+    if name is None:
+        return None
+    value = getattr(v, name)
+    return list(value) if v.type >= 5 else value
+
+
+def read_run(path: str | Path, keep=tuple(SCANNED), namespace: str | None = None) -> RunData:
     """Stream the run's bag into arrays.
 
     ``keep``: the sample-rate topics whose arrays to fill (joint_states, voltage_command,
     plant_state); the others are only counted (not decoded, so not checked) and their arrays
-    left empty. Raises
-    :class:`ConfigError` for a file that is not MCAP or holds no ipfric run.
+    left empty. ``namespace``: the rig to read in a bag of several (None: the bag's only one).
+    Raises :class:`ConfigError` for a file that is not MCAP or holds no ipfric run.
     """
     f = mcap_file(path)
     size = f.stat().st_size
@@ -508,9 +562,13 @@ def read_run(path: str | Path, keep=tuple(SCANNED)) -> RunData:
             raise ConfigError(f'{f}: not an MCAP file ({what}; an MCAP file starts with {MAGIC!r}); give the '
                               f'bag directory or .mcap file of a run (./ipfric run --out DIR writes DIR/bag)')
         mm = mmap.mmap(fh.fileno(), size, access=mmap.ACCESS_READ)   # closed when unreferenced
-    r = _Reader(set(keep) | {'joint_states'}, mm)
+    ns = None if namespace is None else '/' + namespace.strip('/')
+    r = _Reader(set(keep) | {'joint_states'}, mm, ns.rstrip('/') or '/' if ns else None)
     expected = r.summary()
     detail = r.read()
+    if ns is None and len(r.rigs) > 1:
+        raise ConfigError(f'{f}: the bag holds the joint_states of several rigs ({", ".join(sorted(r.rigs))}); '
+                          f'name the one to read (analyze --namespace NS)')
     if expected is not None:
         short = [f'{r.channels[c].topic if c in r.channels else c} {int(r.counts[c])} of {k}'
                  for c, k in sorted(expected.items()) if int(r.counts[c]) != k]
@@ -522,17 +580,57 @@ def read_run(path: str | Path, keep=tuple(SCANNED)) -> RunData:
     if r.bad_messages:
         r.damage.append((f'{r.bad_messages} message(s) did not decode or did not fit in their record', None))
     config = _config(r)
-    counts = {'/' + r.channels[c].topic.lstrip('/'): int(r.counts[c]) for c in sorted(r.channels) if r.counts[c]}
+    counts = {'/' + r.channels[c].topic.lstrip('/'): int(r.counts[c]) for c in sorted(r.channels)}
     j, c, tr = (o[:k] for o, k in zip(r.out, r.n))
     damage = [_located(s, k, j[:, 0]) for s, k in r.damage]
     j, tr = _physical(j, 'joint_states', damage), _physical(tr, 'plant_state', damage)
     if not len(j) and not truncated and not damage:
-        raise ConfigError(f'{f}: no joint_states messages; is this an ipfric run?')
+        where = f' of namespace {r.namespace}' if ns else ''
+        raise ConfigError(f'{f}: no joint_states messages{where}; is this an ipfric run?')
     order = np.argsort(j[:, 0], kind='stable')
     j = j[order]
-    return RunData(str(path), j[:, 0], j[:, 1], j[:, 2], c[:, 0], c[:, 1], tr[:, 0],
-                   {k: tr[:, i + 1] for i, k in enumerate(TRUTH_FIELDS)}, r.events, r.gain, config,
-                   counts, truncated, detail, damage)
+    repeated = int(np.count_nonzero(np.diff(j[:, 0]) <= 0))
+    if repeated:
+        damage.append(f'joint_states: {repeated} sample(s) whose stamp another message has too: a second publisher '
+                      f'on the rig\'s topics (another rig or run in the domain); the samples are not one run\'s')
+    rig = r.namespace or '/'
+    changes = [(t, node, name, value) for t, node, name, value, changed in r.parameter_events
+               if changed and _split(node)[0] == rig]
+    recording = _metadata_json(r, 'ipfric.recording')
+    run = RunData(str(path), j[:, 0], j[:, 1], j[:, 2], c[:, 0], c[:, 1], tr[:, 0],
+                  {k: tr[:, i + 1] for i, k in enumerate(TRUTH_FIELDS)}, r.events, r.gain, config,
+                  counts, truncated, detail, damage, rig, changes, recording)
+    run.incomplete = _incomplete(run)
+    return run
+
+
+def _incomplete(run: RunData) -> str:
+    """Why the bag does not hold the whole run ('' if it does): no terminal event, or fewer
+    messages than the simulator's terminal event says it published."""
+    ends = [d for _, code, d in run.events if code in TERMINAL_EVENTS]
+    if not ends:
+        stopped = (run.recording or {}).get('stopped_by')
+        return ('the run\'s end is not in the bag (no END, ABORT, FALLEN or TRACK_LIMIT event): the recording stopped '
+                'before the run ended' + (f' (the recorder was stopped by {stopped})' if stopped else ''))
+    try:
+        published = json.loads(ends[-1].split('published ', 1)[1])
+    except (IndexError, ValueError):
+        return ''
+    prefix = '' if run.namespace == '/' else run.namespace
+    short = []
+    for topic, n in published.items():
+        name = topic if topic.startswith('/') else f'{prefix}/{topic}'
+        if run.counts.get(name, 0) < n:
+            short.append(f'{name} {run.counts.get(name, 0)} of {n}')
+    return ('the bag holds fewer messages than the simulator published: ' + ', '.join(short)) if short else ''
+
+
+def _metadata_json(r: _Reader, key: str) -> dict | None:
+    """A JSON entry of the ``ipfric`` metadata record (None if absent or not JSON)."""
+    try:
+        return json.loads(r.metadata.get('ipfric', {})[key])
+    except (KeyError, ValueError):
+        return None
 
 
 def _located(sentence: str, before: int | None, t: np.ndarray) -> str:

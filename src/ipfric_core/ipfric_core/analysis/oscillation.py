@@ -15,7 +15,8 @@ import numpy as np
 
 from ..constants import ANGLE_RESOLUTION_RAD, CART_RESOLUTION_M, FALLEN_ANGLE_RAD
 
-__all__ = ['CLASSES', 'Oscillation', 'crossing_period', 'classify', 'balanced_segments', 'regimes']
+__all__ = ['CLASSES', 'Oscillation', 'Regime', 'crossing_period', 'classify', 'balanced_segments', 'regimes',
+           'regime_of']
 
 CLASSES = ('settled', 'limit_cycle', 'irregular', 'growing', 'fallen')
 
@@ -235,6 +236,18 @@ def regimes(t, x, theta, resolution=(4.54e-5, 1.534e-3), window: float = 8.0, st
         out.append(_regime(t, x, theta, resolution, labels[i], float(a), float(b)))
         i = j + 1
     return out
+
+
+def regime_of(t, x, theta, a: float, b: float, resolution=(4.54e-5, 1.534e-3),
+              fallen_angle: float = FALLEN_ANGLE_RAD, window: float = 8.0) -> Regime:
+    """The span [``a``, ``b``] [s] of a run as one regime: the class of its last ``window`` s
+    (:func:`classify`), its amplitudes, periods and sticking (e.g. the stretch between two changes
+    of the controller's delay)."""
+    t, x, theta = (np.asarray(v, float) for v in (t, x, theta))
+    m = (t >= a) & (t <= b)
+    span = float(t[m][-1] - t[m][0]) if m.sum() > 1 else 0.0
+    cls = classify(t[m], x[m], theta[m], resolution, fallen_angle, window=min(window, 0.5 * span) or window).cls
+    return _regime(t, x, theta, resolution, cls, a, b)
 
 
 def _regime(t, x, theta, resolution, cls: str, a: float, b: float) -> Regime:

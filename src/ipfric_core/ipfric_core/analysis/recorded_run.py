@@ -24,11 +24,11 @@ from ..constants import (
 )
 from ..physics.params import ConfigError
 from .bagread import RunData, read_run
-from .oscillation import balanced_segments, classify, regimes
+from .oscillation import balanced_segments, classify, regime_of, regimes
 from .plots import overlay_figure, run_figure
 from .records import load, smallest_step
 
-__all__ = ['analyze_run', 'overlay_runs', 'analyze_log']
+__all__ = ['LOOP_PARAMETERS', 'parameter_changes', 'parameter_regimes', 'analyze_run', 'overlay_runs', 'analyze_log']
 
 
 def _resolution(run: RunData) -> tuple[float, float]:
@@ -44,21 +44,62 @@ def run_name(path: str | Path) -> str:
     return p.name.removesuffix('.mcap') or 'run'
 
 
-def analyze_run(path: str | Path, plot_dir: str | Path | None = None, window: float = 10.0) -> dict:
-    """Classify one run from its bag; write its figure to ``plot_dir`` if given."""
-    run = read_run(path, keep=(JOINT_STATES,) if plot_dir is None else (JOINT_STATES, VOLTAGE_COMMAND, PLANT_STATE))
+#: Controller parameters whose run-time change starts a new regime of the loop.
+LOOP_PARAMETERS = ('delay', 'gain', 'cutoff_hz', 'voltage_limit')
+
+
+def parameter_changes(run: RunData) -> list[dict]:
+    """The run-time changes of the controller's loop parameters in the bag (``/parameter_events``):
+    simulated time [s], node, parameter, the value before (the run's configuration, or the change
+    before) and after."""
+    before = dict((run.config or {}).get('controller', {}))
+    before['gain'] = (run.config or {}).get('gain')
+    out = []
+    for t, node, name, value in run.parameter_changes:
+        if name in LOOP_PARAMETERS and node.endswith('/controller_node'):
+            out.append({'t': float(t), 'node': node, 'parameter': name, 'before': before.get(name), 'after': value})
+            before[name] = value
+    return out
+
+
+def parameter_regimes(run: RunData, changes: list[dict], resolution, fallen: float) -> list[dict]:
+    """The run cut where a change gave a parameter a new value: each stretch as one regime (class,
+    amplitudes, periods) and the changes it starts with."""
+    if not changes or len(run.t) < 2:
+        return []
+    moved = [c for c in changes if c['after'] != c['before']]
+    cuts = [float(run.t[0])] + sorted({c['t'] for c in moved if run.t[0] < c['t'] < run.t[-1]}) + [float(run.t[-1])]
+    out = []
+    for a, b in zip(cuts, cuts[1:]):
+        if b - a < 2 * (run.t[1] - run.t[0]):
+            continue
+        out.append({**regime_of(run.t, run.x, run.theta, a, b, resolution, fallen).to_dict(),
+                    'after': [f'{c["parameter"]} {c["after"]}' for c in moved if c['t'] == a]})
+    return out
+
+
+def analyze_run(path: str | Path, plot_dir: str | Path | None = None, window: float = 10.0,
+                namespace: str | None = None) -> dict:
+    """Classify one run from its bag (the rig of ``namespace`` in a bag of several); write its
+    figure to ``plot_dir`` if given. A run whose controller parameters changed while it ran is
+    also cut at each change into regimes (``parameter_regimes``)."""
+    run = read_run(path, keep=(JOINT_STATES,) if plot_dir is None else (JOINT_STATES, VOLTAGE_COMMAND, PLANT_STATE),
+                   namespace=namespace)
     sim = (run.config or {}).get('sim', {})
     fallen = sim.get('fallen_angle', FALLEN_ANGLE_RAD)
     ended = run.end_reason in LIMITS
     if len(run.t) < 2:
         return {'path': str(path), 'class': None, 'samples': int(len(run.t)), 'truncated': run.truncated,
-                'truncation_detail': run.truncation_detail, 'damage': run.damage, 'error': 'fewer than 2 samples'}
+                'truncation_detail': run.truncation_detail, 'damage': run.damage, 'incomplete': run.incomplete,
+                'error': 'fewer than 2 samples'}
     o = classify(run.t, run.x, run.theta, _resolution(run), fallen, ended_fallen=ended,
                  window=min(window, 0.5 * float(run.t[-1] - run.t[0]) or window))
-    out = {'path': str(path), 'samples': int(len(run.t)), 'duration_s': float(run.t[-1] - run.t[0]),
-           'end_reason': run.end_reason, 'truncated': run.truncated,
-           'truncation_detail': run.truncation_detail, 'damage': run.damage, 'counts': run.counts,
-           'gain': run.gain,
+    changes = parameter_changes(run)
+    spans = parameter_regimes(run, changes, _resolution(run), fallen)
+    out = {'path': str(path), 'namespace': run.namespace, 'samples': int(len(run.t)),
+           'duration_s': float(run.t[-1] - run.t[0]), 'end_reason': run.end_reason, 'truncated': run.truncated,
+           'truncation_detail': run.truncation_detail, 'damage': run.damage, 'incomplete': run.incomplete,
+           'counts': run.counts, 'gain': run.gain, 'parameter_changes': changes, 'parameter_regimes': spans,
            **{('class' if k == 'cls' else k): v for k, v in o.to_dict().items()}, **loop_timing(path)}
     if plot_dir is not None:
         d = Path(plot_dir)
@@ -69,7 +110,7 @@ def analyze_run(path: str | Path, plot_dir: str | Path | None = None, window: fl
             title += f', x p2p {o.x_p2p * 100:.2f} cm, period {o.period_crossings:.2f} s'
         phase = (run.truth['theta'], run.truth['theta_dot']) if len(run.truth_t) else None
         out['figure'] = str(run_figure(run.t, run.x, run.theta, run.command_t, run.voltage, title,
-                                       d / f'{name}.png', phase))
+                                       d / f'{name}.png', phase, [(r['start'], r['end'], r['cls']) for r in spans]))
     return out
 
 
@@ -115,9 +156,9 @@ def alignment_shift(t_ref, x_ref, t, x) -> tuple[float, float]:
     return shift_t, shift_x
 
 
-def overlay_runs(paths, plot_path: str | Path) -> dict:
+def overlay_runs(paths, plot_path: str | Path, namespace: str | None = None) -> dict:
     """Overlay the cart position of several runs, each aligned on the first."""
-    runs = [read_run(p) for p in paths]
+    runs = [read_run(p, namespace=namespace) for p in paths]
     ref = runs[0]
     shifts = [(0.0, 0.0)] + [alignment_shift(ref.t, ref.x, r.t, r.x) for r in runs[1:]]
     fig = overlay_figure([(r.t, r.x) for r in runs], [Path(p).name for p in paths], shifts, plot_path)

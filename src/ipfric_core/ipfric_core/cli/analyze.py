@@ -1,7 +1,8 @@
 """``./ipfric analyze``: recorded runs (bags) and rig logs, offline, no ROS.
 
-Exit code 0: every bag intact; 1: a bag truncated or damaged (what was read is analysed,
-the loss stated); 2: an input refused (not an MCAP file, no bag)."""
+Exit code 0: every bag intact and complete; 1: a bag truncated or damaged, or holding an
+incomplete run (no end event, fewer messages than the simulator published; what was read is
+analysed, the loss stated); 2: an input refused (not an MCAP file, no bag)."""
 from __future__ import annotations
 
 import math
@@ -24,6 +25,8 @@ def add_arguments(a) -> None:
     a.add_argument('runs', nargs='+', help='run directory, rosbag2 directory, .mcap file, or a rig log .csv/.mat')
     a.add_argument('--plots', default='runs/analysis', help='directory for PNG figures (default %(default)s)')
     a.add_argument('--no-plots', action='store_true', help='numbers only')
+    a.add_argument('--namespace', default=None,
+                   help='the rig to read in a bag that holds several (e.g. /rig1); default: the bag\'s only one')
     a.add_argument('--columns', help='rig log: CSV column mapping, e.g. t=time_s,x=cart_m,voltage=u_V,theta=angle_rad')
     a.add_argument('--angle-zero', choices=ANGLE_ZEROS, default='auto',
                    help='rig log: where its angle is zero (default %(default)s: hanging if mostly far from upright)')
@@ -35,9 +38,13 @@ def add_arguments(a) -> None:
 
 def print_run_analysis(r: dict) -> None:
     """Readable summary of one :func:`~ipfric_core.analysis.recorded_run.analyze_run` result."""
-    print(f'{r["path"]}: {r["class"]}' + (' (TRUNCATED: ' + r['truncation_detail'] + ')' if r['truncated'] else ''))
+    rig = '' if r.get('namespace', '/') == '/' else f' (rig {r["namespace"]})'
+    print(f'{r["path"]}{rig}: {r["class"]}'
+          + (' (TRUNCATED: ' + r['truncation_detail'] + ')' if r['truncated'] else ''))
     for d in r.get('damage', ()):
         print(f'  DAMAGED: {d}')
+    if r.get('incomplete'):
+        print(f'  INCOMPLETE: {r["incomplete"]}')
     if r.get('class') is None:
         return
     tt = r['transition_time']
@@ -50,6 +57,13 @@ def print_run_analysis(r: dict) -> None:
         print(f'  period: {pc and round(pc, 3)} s (zero crossings), {ps and round(ps, 3)} s (spectrum)'
               + ('' if r['periods_agree'] else ': estimates disagree, an irregular oscillation')
               + (f'; {r["frequency"]:.3f} Hz' if r['frequency'] else ''))
+    for c in r.get('parameter_changes', ()):
+        print(f'  t = {c["t"]:.3f} s: {c["node"]} {c["parameter"]} {c["before"]} -> {c["after"]}')
+    for g in r.get('parameter_regimes', ()):
+        pc = g['period_crossings']
+        print(f'    {g["start"]:7.3f}-{g["end"]:7.3f} s  {g["cls"]:<11}  cart p2p {g["x_p2p"] * 100:.3f} cm, angle p2p '
+              f'{math.degrees(g["theta_p2p"]):.4f} deg' + (f', period {pc:.3f} s' if pc else '')
+              + (f'  (after {", ".join(g["after"])})' if g['after'] else ''))
     if r.get('samples_without_command') is not None:
         lat = r.get('command_latency_s') or {}
         print(f'  {r["time_mode"]}: {r["samples_without_command"]} samples without a fresh command '
@@ -90,11 +104,11 @@ def main(args) -> int:
         for r in [] if args.json else results:
             print_log_analysis(r)
         return 0
-    results = [analyze_run(p, plots) for p in args.runs]
+    results = [analyze_run(p, plots, namespace=args.namespace) for p in args.runs]
     out: dict = {'runs': results}
     if len(args.runs) > 1 and not args.no_plots:
-        out['overlay'] = overlay_runs(args.runs, Path(args.plots) / 'overlay.png')
-    code = 1 if any(r['truncated'] or r['damage'] for r in results) else 0
+        out['overlay'] = overlay_runs(args.runs, Path(args.plots) / 'overlay.png', args.namespace)
+    code = 1 if any(r['truncated'] or r['damage'] or r['incomplete'] for r in results) else 0
     if args.json:
         print_json(out)
         return code

@@ -16,9 +16,9 @@ from pathlib import Path
 import yaml
 
 from ..physics.params import ConfigError, load_yaml
-from .scenario import load_scenario
+from .scenario import SECTION_KEYS, load_scenario, node_sections, scenario_from_sections, scenario_path
 
-__all__ = ['NODES', 'OVERRIDES', 'parse_overrides', 'write_run_scenario', 'node_parameters', 'ros_args']
+__all__ = ['NODES', 'OVERRIDES', 'REALTIME', 'parse_overrides', 'write_run_scenario', 'node_parameters', 'ros_args']
 
 #: The processes of a run in start order: name -> (package, executable).
 NODES = {
@@ -61,48 +61,65 @@ def parse_overrides(values: dict) -> dict:
     return out
 
 
-def write_run_scenario(config, out, overrides: dict | None = None) -> Path:
-    """Validate ``config`` with ``overrides`` applied; write it to ``out``/scenario.yaml.
+def write_run_scenario(config, out, overrides: dict | None = None, namespace: str = '/') -> Path:
+    """Validate ``config`` (a path or an installed scenario's name) as the nodes in ``namespace``
+    read it, with ``overrides`` applied; then write it to ``out``/scenario.yaml, one section per
+    node in the wildcard form (``/**/sim_node``).
 
-    Raises ConfigError (named field) for a bad scenario or a bag already in ``out``.
+    Raises ConfigError (named field) for a bad scenario or a bag already in ``out``; nothing is
+    created then.
     """
-    config, out = Path(config), Path(out)
-    load_scenario(config)
-    data = load_yaml(config)
+    config, out = scenario_path(config), Path(out)
+    sections = node_sections(load_yaml(config), namespace, config)
+    scenario_from_sections(sections, config, namespace)
     overrides = dict(overrides or {})
     duration = overrides.get('duration')
     if duration is not None and not (math.isfinite(duration) and duration >= 0):
         raise ConfigError(f'duration: {duration!r} must be >= 0 s (simulated seconds)')
     for name, value in overrides.items():
         node, param = OVERRIDES[name][:2]
-        data[node]['ros__parameters'][param] = value
-    out.mkdir(parents=True, exist_ok=True)
+        sections[node][param] = value
+    scenario_from_sections(sections, f'{config} with {overrides}', namespace)
     if (out / BAG_NAME).exists():
         raise ConfigError(f'{out / BAG_NAME} exists already; choose another output directory')
+    out.mkdir(parents=True, exist_ok=True)
     path = out / CONFIG_NAME
     header = f'# ipfric run of {config}' + ''.join(f', {k} {v}' for k, v in overrides.items()) + '\n'
+    data = {SECTION_KEYS[node]: {'ros__parameters': params} for node, params in sections.items()}
     path.write_text(header + yaml.safe_dump(data, sort_keys=False))
-    load_scenario(path)
     return path
+
+
+#: What the sample loop of a realtime run gets (ipfric_ros.realtime), by node: real-time
+#: scheduling of every thread (refused without the privilege, which the nodes log); the recorder
+#: stays at its default niceness below them. Binding each to a CPU of its own was measured and
+#: left out: on 2 cores a process's middleware threads then wait for its loop (docs/ros-stack.md).
+REALTIME = {'sim_node': {'realtime_priority': 80}, 'controller_node': {'realtime_priority': 79}}
 
 
 def node_parameters(scenario, out) -> dict:
     """Every node's (parameter file or None, parameters on top of it), by node name.
 
     ``scenario``: the run scenario (:func:`write_run_scenario`); ``out``: the run directory
-    (bag in ``out``/bag, the simulator's result in ``out``/sim_result.json).
+    (bag in ``out``/bag, the simulator's result in ``out``/sim_result.json). A realtime run adds
+    :data:`REALTIME`.
     """
+    realtime = load_scenario(scenario).sim.time_mode == 'realtime'
     scenario, out = str(scenario), Path(out)
-    return {
+    params = {
         'recorder': (None, {'output': str(out / BAG_NAME), 'scenario_file': scenario}),
-        'controller_node': (scenario, {'min_command_subscribers': 2, 'use_sim_time': True}),
-        'sim_node': (scenario, {'wait_for_recorder': True, 'result_file': str(out / RESULT_NAME)}),
+        'controller_node': (scenario, {'use_sim_time': True}),
+        'sim_node': (scenario, {'result_file': str(out / RESULT_NAME)}),
     }
+    for name, extra in REALTIME.items() if realtime else ():
+        params[name][1].update(extra)
+    return params
 
 
-def ros_args(params_file, params: dict) -> list:
-    """``--ros-args`` arguments (without that flag) for a parameter file and parameters."""
-    args = ['--params-file', str(params_file)] if params_file else []
+def ros_args(params_file, params: dict, namespace: str = '/') -> list:
+    """``--ros-args`` arguments (without that flag) for a parameter file and parameters, in ``namespace``."""
+    args = ['-r', f'__ns:={namespace}'] if namespace not in ('/', '', None) else []
+    args += ['--params-file', str(params_file)] if params_file else []
     for k, v in params.items():
         args += ['-p', f'{k}:={str(v).lower() if isinstance(v, bool) else v}']
     return args

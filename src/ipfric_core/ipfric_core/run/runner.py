@@ -30,6 +30,7 @@ This module starts processes only; it imports no ROS package.
 from __future__ import annotations
 
 import ctypes
+import fcntl
 import json
 import math
 import os
@@ -37,6 +38,7 @@ import random
 import signal
 import socket
 import subprocess
+import tempfile
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -46,8 +48,10 @@ import yaml
 from ..constants import LIMITS, REPO_ROOT
 from ..physics.params import ConfigError
 from .nodes import NODES, node_parameters, ros_args, write_run_scenario
+from .scenario import check_namespace
 
-__all__ = ['EXIT_FELL', 'SUPERVISED', 'die_with_parent', 'ros_environment', 'pick_domain', 'RunResult', 'Run', 'run']
+__all__ = ['EXIT_FELL', 'EXIT_FAULT', 'SUPERVISED', 'DomainLock', 'die_with_parent', 'ros_environment', 'domain_in_use',
+           'pick_domain', 'claim_domain', 'executable', 'RunResult', 'Run', 'run']
 
 #: Exit codes of a run besides 0, 1 (a node failed), 2 (bad input) and 130 (Ctrl-C).
 EXIT_FAULT = 3    # a safety fault: watchdog, stall, refused commands, unexpected publisher
@@ -80,22 +84,72 @@ def ros_environment(domain: int) -> dict:
     return env
 
 
-def domain_in_use(domain: int) -> bool:
-    """True when the first participant's unicast discovery port of ``domain`` is taken.
+#: Participants of one domain whose discovery port is probed (Fast DDS fits 120 in a domain's 250 ports).
+PARTICIPANTS = 120
+#: Where the runs of this machine hold their domain (and namespace) locks.
+LOCKS = Path(tempfile.gettempdir()) / 'ipfric-ros-domains'
 
-    Fast DDS: port = 7400 + 250 * domain + 10 (+ 2 per further participant).
+
+def domain_in_use(domain: int) -> bool:
+    """True when any participant's unicast discovery port of ``domain`` is taken.
+
+    Fast DDS: port = 7400 + 250 * domain + 10 + 2 * participant (a participant takes the first
+    free one, so the one of participant 0 may be free while later ones still run).
     """
-    port = 7400 + 250 * domain + 10
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
-        try:
-            s.bind(('0.0.0.0', port))
-        except OSError:
-            return True
+    for participant in range(PARTICIPANTS):
+        port = 7400 + 250 * domain + 10 + 2 * participant
+        if port > 65535:            # the last domains hold fewer participants
+            break
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+            try:
+                s.bind(('0.0.0.0', port))
+            except OSError:
+                return True
     return False
 
 
+class DomainLock:
+    """A ROS domain held by one run of this machine, from the check that it is free to the run's end.
+
+    A run at the root namespace holds its domain alone (an exclusive ``flock``); a run in a
+    namespace shares the domain with runs in other namespaces (a shared lock) and holds its
+    namespace alone. The locks go with the process however it ends, so a killed run frees them.
+    """
+
+    def __init__(self, domain: int, namespace: str = '/'):
+        self.domain, self.namespace = domain, namespace
+        self.files: list = []
+
+    def _take(self, name: str, exclusive: bool) -> bool:
+        LOCKS.mkdir(parents=True, exist_ok=True)
+        f = open(LOCKS / name, 'a')
+        try:
+            fcntl.flock(f, (fcntl.LOCK_EX if exclusive else fcntl.LOCK_SH) | fcntl.LOCK_NB)
+        except OSError:
+            f.close()
+            return False
+        self.files.append(f)
+        return True
+
+    def acquire(self) -> str | None:
+        """Take the locks; None, or why the domain (or namespace) is not free."""
+        shared = self.namespace != '/'
+        if not self._take(f'domain-{self.domain}', exclusive=not shared):
+            return (f'ROS domain {self.domain} is in use by another ./ipfric run'
+                    + (' at the root namespace' if shared else ''))
+        if shared and not self._take(f'domain-{self.domain}{self.namespace.replace("/", "-")}', exclusive=True):
+            self.release()
+            return f'namespace {self.namespace} of ROS domain {self.domain} is in use by another ./ipfric run'
+        return None
+
+    def release(self) -> None:
+        for f in self.files:
+            f.close()
+        self.files = []
+
+
 def pick_domain(rng: random.Random | None = None) -> int:
-    """A ROS_DOMAIN_ID in 1..232 that no participant on this machine uses."""
+    """A ROS_DOMAIN_ID in 1..232 that no participant on this machine uses (not held: see :func:`claim_domain`)."""
     rng = rng or random.Random(os.getpid() ^ time.monotonic_ns())
     candidates = list(range(max(1, DOMAINS[0]), DOMAINS[1] + 1))
     rng.shuffle(candidates)
@@ -103,6 +157,40 @@ def pick_domain(rng: random.Random | None = None) -> int:
         if not domain_in_use(d):
             return d
     raise RuntimeError('no free ROS domain id in 1..232')
+
+
+def claim_domain(domain: int | None = None, namespace: str = '/') -> DomainLock:
+    """The domain of a run, held until :meth:`DomainLock.release` (or the process's end).
+
+    ``domain`` None: a free one (no participant, no other run's lock), taken atomically, so two
+    runs started at once never pick the same. A given domain is refused (ConfigError) when another
+    ./ipfric run holds it, or, at the root namespace, when any participant uses it; a run in a
+    namespace may share a domain with other rigs (each in its namespace) but not its namespace.
+    """
+    if domain is None:
+        rng = random.Random(os.getpid() ^ time.monotonic_ns())
+        candidates = list(range(max(1, DOMAINS[0]), DOMAINS[1] + 1))
+        rng.shuffle(candidates)
+        for d in candidates:
+            if domain_in_use(d):
+                continue
+            lock = DomainLock(d)
+            if lock.acquire() is None:
+                if not domain_in_use(d):
+                    return lock
+                lock.release()
+        raise RuntimeError('no free ROS domain id in 1..232')
+    if not DOMAINS[0] <= domain <= DOMAINS[1]:
+        raise ConfigError(f'--domain: {domain} is out of range; allowed {DOMAINS[0]}..{DOMAINS[1]}')
+    lock = DomainLock(domain, namespace)
+    why = lock.acquire()
+    if why is None and namespace == '/' and domain_in_use(domain):
+        lock.release()
+        why = f'ROS domain {domain} is in use by another process on this machine'
+    if why:
+        raise ConfigError(f'--domain: {why}; give another, leave --domain out (a free one is picked)'
+                          + ('' if namespace != '/' else ', or run in a --namespace of its own'))
+    return lock
 
 
 def executable(name: str) -> Path:
@@ -125,13 +213,14 @@ def describe_exit(code: int | None) -> str:
 
 
 def last_problem(log: Path) -> str:
-    """The last FATAL/ERROR line (or traceback line) of a node log, for the message."""
+    """The last FATAL/ERROR line (or traceback line, or the signal that stopped it) of a node log,
+    for the message."""
     try:
         lines = log.read_text(errors='replace').splitlines()
     except OSError:
         return ''
     for line in reversed(lines):
-        if '[FATAL]' in line or '[ERROR]' in line or 'Error' in line:
+        if '[FATAL]' in line or '[ERROR]' in line or 'Error' in line or 'stopped by SIG' in line:
             return line.strip()
     return ''
 
@@ -157,6 +246,7 @@ class RunResult:
     interrupted: bool = False
     exit_codes: dict = field(default_factory=dict)
     bag_loss: list = field(default_factory=list)
+    namespace: str = '/'
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -166,7 +256,8 @@ class RunResult:
         if self.end_reason:
             lines.append(f'run: {self.end_reason} ({self.detail}) after {self.samples} samples '
                          f'({self.sim_time_s:.3f} s simulated) in {self.wall_time_s:.1f} s wall '
-                         f'({self.steps_per_s:.0f} samples/s), ROS domain {self.domain}')
+                         f'({self.steps_per_s:.0f} samples/s), ROS domain {self.domain}'
+                         + ('' if self.namespace == '/' else f', namespace {self.namespace}'))
         else:
             lines.append(f'run: no end reason (the simulator did not finish), ROS domain {self.domain}')
         if self.recorded:
@@ -193,10 +284,15 @@ class Run:
 
     Parameters
     ----------
-    config : scenario parameter file (sim_node / controller_node sections)
+    config : scenario parameter file (sim_node / controller_node sections), or an installed scenario's name
     out : output directory (created; must not hold a bag yet)
     duration : simulated seconds, overriding the file's sim_node duration (None = keep)
     domain : ROS_DOMAIN_ID (None = a free one)
+    namespace : the rig's ROS namespace (``/rig1``; None = the root); with a given ``domain``,
+        rigs in different namespaces share it
+    time_mode : lockstep | realtime, overriding the file's (None = keep)
+    node_params : node name -> parameters set on top of what the run gives it (e.g. the loop tuning
+        of :mod:`ipfric_ros.realtime` to compare settings)
     timeout : wall seconds after which the simulator is stopped (None = none)
     grace : wall seconds the simulator may run on after the controller died (its
         watchdog acts) before it is stopped
@@ -204,16 +300,20 @@ class Run:
     """
 
     def __init__(self, config, out, duration: float | None = None, domain: int | None = None,
-                 timeout: float | None = None, grace: float = 20.0, sim_params: dict | None = None,
-                 stop_wait: float = 20.0):
-        self.config = Path(config)
+                 timeout: float | None = None, grace: float = 20.0, node_params: dict | None = None,
+                 stop_wait: float = 20.0, namespace: str | None = None, time_mode: str | None = None):
+        self.config = config
         self.out = Path(out).resolve()  # the nodes run with cwd = out
         self.duration = duration
         self.domain = domain
+        self.namespace = namespace
+        self.time_mode = time_mode
+        self.lock: DomainLock | None = None
+        self.signalled_sim = False      # the runner asked the simulator to stop
         self.timeout = timeout
         self.grace = grace
         self.stop_wait = stop_wait
-        self.sim_params = dict(sim_params or {})
+        self.node_params = {name: dict(p) for name, p in (node_params or {}).items()}
         self.procs: dict[str, subprocess.Popen] = {}
         self.logs: dict[str, Path] = {}
         self.failures: list[str] = []
@@ -222,13 +322,9 @@ class Run:
 
     # -- start -----------------------------------------------------------------------------
     def prepare(self) -> Path:
-        """Validate the arguments and the scenario, then write OUT/scenario.yaml (raises ConfigError)."""
-        if self.domain is not None:
-            if not DOMAINS[0] <= self.domain <= DOMAINS[1]:
-                raise ConfigError(f'--domain: {self.domain} is out of range; allowed {DOMAINS[0]}..{DOMAINS[1]}')
-            if domain_in_use(self.domain):
-                raise ConfigError(f'--domain: ROS domain {self.domain} is in use by another process on this '
-                                  f'machine; give another or leave --domain out (a free one is picked)')
+        """Validate the arguments and the scenario, hold the run's ROS domain, then write
+        OUT/scenario.yaml (raises ConfigError, nothing written and no domain held)."""
+        self.namespace = check_namespace(self.namespace)
         if self.timeout is not None and not (math.isfinite(self.timeout) and self.timeout > 0):
             raise ConfigError(f'--timeout: {self.timeout!r} must be > 0 wall seconds')
         if self.out.exists() and not self.out.is_dir():
@@ -237,21 +333,29 @@ class Run:
             raise ConfigError(f'{self.out / "bag"} exists already; choose another --out')
         if self.duration is not None and not (math.isfinite(self.duration) and self.duration >= 0):
             raise ConfigError(f'--duration: {self.duration!r} must be >= 0 s')
-        return write_run_scenario(self.config, self.out,
-                                  None if self.duration is None else {'duration': float(self.duration)})
+        overrides: dict = {} if self.duration is None else {'duration': float(self.duration)}
+        if self.time_mode is not None:
+            overrides['time_mode'] = self.time_mode
+        self.lock = claim_domain(self.domain, self.namespace)
+        self.domain = self.lock.domain
+        try:
+            return write_run_scenario(self.config, self.out, overrides, self.namespace)
+        except BaseException:
+            self.lock.release()
+            raise
 
     def start(self) -> None:
         cfg = self.prepare()
-        if self.domain is None:
-            self.domain = pick_domain()
-        env = ros_environment(self.domain)
+        assert self.lock is not None and self.namespace is not None
+        env = ros_environment(self.lock.domain)
         logdir = self.out / 'logs'
         logdir.mkdir(exist_ok=True)
         env['ROS_LOG_DIR'] = str(logdir / 'ros')
         env[SUPERVISED] = '1'
         params = node_parameters(cfg, self.out)
-        params['sim_node'][1].update(self.sim_params)
-        args = {name: ros_args(*params[name]) for name in NODES}
+        for name, extra in self.node_params.items():
+            params[name][1].update(extra)
+        args = {name: ros_args(params[name][0], params[name][1], self.namespace) for name in NODES}
         self.t0 = time.monotonic()
         for name in NODES:
             exe = executable(name)
@@ -333,6 +437,7 @@ class Run:
             if stop_at is not None and now >= stop_at:
                 self._signal('sim_node')
                 signalled = now
+                self.signalled_sim = True
         if sim.returncode != 0 and not (signalled is not None and self.failures):
             # (a simulator stopped by the runner after a named failure is not a second failure)
             self.failures.append(self._died('sim_node'))
@@ -356,6 +461,8 @@ class Run:
             for p in self.procs.values():
                 if p.stdin:
                     p.stdin.close()
+            if self.lock is not None:
+                self.lock.release()
         return self.result()
 
     # -- result ----------------------------------------------------------------------------
@@ -367,13 +474,16 @@ class Run:
             pass
         recorded, loss = self.recorded()
         published = sim.get('published', {})
+        if sim.get('stopped_by') and not self.signalled_sim and not self.interrupted:
+            self.failures.append(f'sim_node was stopped by {sim["stopped_by"]} from outside ./ipfric run after '
+                                 f'{sim.get("samples")} samples ({sim.get("sim_time_s", 0):.3f} s simulated): '
+                                 f'the run did not end by itself')
         match = None
         if published and recorded:
-            got = {t: recorded.get('/' + t.lstrip('/'), 0) for t in published}
-            intruded = {t.lstrip('/') for t in sim.get('intruders', {})}
+            got = {t: recorded.get(t, 0) for t in published}
+            intruded = set(sim.get('intruders', {}))
             # more than published on a topic another writer used: its messages, reported as INTRUDER
-            bad = {t: n for t, n in published.items()
-                   if got[t] < n or (got[t] > n and t.lstrip('/') not in intruded)}
+            bad = {t: n for t, n in published.items() if got[t] < n or (got[t] > n and t not in intruded)}
             match = not bad
             if bad:
                 lost = ', '.join(f'{t} {got[t]} of {n}' for t, n in bad.items())
@@ -395,7 +505,8 @@ class Run:
                         wall_time_s=sim.get('wall_time_s'), steps_per_s=sim.get('steps_per_s'),
                         published=published, recorded=recorded, counts_match=match,
                         failures=list(self.failures), faults=faults, interrupted=self.interrupted,
-                        exit_codes={n: p.returncode for n, p in self.procs.items()}, bag_loss=loss)
+                        exit_codes={n: p.returncode for n, p in self.procs.items()}, bag_loss=loss,
+                        namespace=self.namespace or '/')
         (self.out / 'summary.json').write_text(json.dumps(res.to_dict(), indent=2))
         return res
 
@@ -427,8 +538,8 @@ def sim_faults(sim: dict) -> list[str]:
     if sim.get('commands_refused'):
         kinds = ', '.join(f'{n} {k}' for k, n in sorted(sim.get('refused_by_kind', {}).items()))
         out.append(f'{sim["commands_refused"]} command(s) refused ({kinds})')
-    for topic, n in sorted(sim.get('intruders', {}).items()):
-        out.append(f'{n} unexpected publisher(s) on {topic}')
+    for topic, nodes in sorted(sim.get('intruders', {}).items()):
+        out.append(f'{len(nodes)} unexpected publisher(s) on {topic}: {", ".join(nodes)}')
     return out
 
 

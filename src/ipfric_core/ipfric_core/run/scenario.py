@@ -1,8 +1,9 @@
 """A run scenario: one ROS 2 parameter file for the simulator and controller nodes.
 
-The file is an ordinary ``--params-file`` YAML::
+The file is an ordinary ``--params-file`` YAML, its sections keyed in the ROS wildcard form
+that matches the nodes in any namespace (``/**/sim_node``; rcl's rules, :func:`key_matches`)::
 
-    sim_node:
+    /**/sim_node:
       ros__parameters:
         sample_rate_hz: 1000.0   # [Hz]
         duration: 20.0           # [s], 0 = until stopped
@@ -18,7 +19,7 @@ The file is an ordinary ``--params-file`` YAML::
         plant: {M: ..., m: ..., l: ..., g: ..., alpha: ..., beta: ...}
         friction: {model: exponential, eps: ..., ...}
         plant_truth: {cogging_N: 0.0, ...}           # undeclared effects, rig.PlantTruth
-    controller_node:
+    /**/controller_node:
       ros__parameters:
         sample_rate_hz: 1000.0
         gain_source: yaml        # yaml | design
@@ -38,6 +39,8 @@ from __future__ import annotations
 
 import difflib
 import math
+import os
+import re
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
@@ -64,7 +67,9 @@ from ..physics.params import (
 from ..physics.plant import CartPendulum
 from ..physics.rig import PLANT_TRUTH_FIELDS, PlantTruth, Rig
 
-__all__ = ['DEFAULT_SCENARIO', 'Scenario', 'nest', 'scenario_from_ros_params', 'load_scenario']
+__all__ = ['DEFAULT_SCENARIO', 'TIME_MODES', 'NODE_NAMES', 'SECTION_KEYS', 'Scenario', 'check_namespace', 'key_matches',
+           'nest', 'node_sections', 'scenario_from_ros_params', 'scenario_from_sections', 'load_scenario',
+           'scenario_path']
 
 #: the scenario ``./ipfric run`` and the other commands take when none is given
 DEFAULT_SCENARIO = REPO_ROOT / 'config' / 'default.yaml'
@@ -236,7 +241,8 @@ class Scenario:
             ctrl['gain'] = list(c.gain)
         if c.design_friction is not None:
             ctrl['design_friction'] = c.design_friction.to_dict()
-        return {'sim_node': {'ros__parameters': sim}, 'controller_node': {'ros__parameters': ctrl}}
+        return {SECTION_KEYS['sim_node']: {'ros__parameters': sim},
+                SECTION_KEYS['controller_node']: {'ros__parameters': ctrl}}
 
     @staticmethod
     def flat_defaults(node: str) -> dict:
@@ -304,41 +310,127 @@ def scenario_from_ros_params(sim_params: Mapping | None, controller_params: Mapp
     return Scenario(sim, plant, friction, truth, ctrl)
 
 
-def load_scenario(path: str | Path) -> Scenario:
-    """Load a scenario parameter file (both node sections required)."""
-    data = load_yaml(path)
-    sections = {}
+#: The nodes a scenario file has sections for.
+NODE_NAMES = ('sim_node', 'controller_node', 'recorder')
+#: The key of each node's section as ipfric writes it: the ROS wildcard form, which matches the
+#: node in any namespace (``sim_node:`` alone matches only ``/sim_node``).
+SECTION_KEYS = {name: f'/**/{name}' for name in NODE_NAMES}
+#: A ROS namespace: ``/`` or ``/`` + tokens of letters, digits and ``_`` not starting with a digit.
+NAMESPACE = re.compile(r'/|(/[A-Za-z_][A-Za-z0-9_]*)+')
+
+
+def check_namespace(namespace: str | None, path: str = '--namespace') -> str:
+    """``namespace`` as a fully qualified ROS namespace ('' or None: the root ``/``); ConfigError if not one."""
+    ns = namespace or '/'
+    ns = ns if ns.startswith('/') else '/' + ns
+    ns = ns.rstrip('/') or '/'
+    if not NAMESPACE.fullmatch(ns):
+        raise ConfigError(f'{path}: {namespace!r} is not a ROS namespace; allowed: tokens of letters, digits and _ '
+                          f'(not starting with a digit) separated by /, e.g. /rig1 or /lab/rig2')
+    return ns
+
+
+def key_matches(key: str, fqn: str) -> bool:
+    """Whether the parameter-file key ``key`` applies to the node ``fqn`` (e.g. ``/rig1/sim_node``) by
+    rcl's rules: ``/**`` any number of namespace tokens, ``/*`` one token, no leading ``/`` = from the root."""
+    parts = ('/' + key.lstrip('/')).split('/')[1:]
+    rx = ''.join('(?:/[^/]+)*' if t == '**' else '/[^/]+' if t == '*' else '/' + re.escape(t) for t in parts)
+    return re.fullmatch(rx, fqn) is not None
+
+
+def _merge(into: dict, more: Mapping) -> dict:
+    for k, v in more.items():
+        if isinstance(v, Mapping) and isinstance(into.get(k), dict):
+            _merge(into[k], v)
+        else:
+            into[k] = dict(v) if isinstance(v, Mapping) else v
+    return into
+
+
+def _one_type_arrays(path: str, value: Any) -> None:
+    """rcl's parameter parser takes an array of one type only: refuse ``[70, 142.5]`` here, naming it."""
+    if isinstance(value, Mapping):
+        for k, v in value.items():
+            _one_type_arrays(f'{path}.{k}', v)
+    elif isinstance(value, list) and len({type(v) for v in value}) > 1:
+        kinds = ', '.join(sorted({type(v).__name__ for v in value}))
+        fixed = [float(v) if isinstance(v, int) and not isinstance(v, bool) else v for v in value]
+        raise ConfigError(f'{path}: {value!r} mixes {kinds}; a ROS parameter array has one type (rcl refuses the '
+                          f'file): write every number with a decimal point, e.g. {fixed!r}')
+
+
+def node_sections(data: Mapping, namespace: str = '/', path: str | Path = '<scenario>') -> dict:
+    """The ``ros__parameters`` each node of ``NODE_NAMES`` in ``namespace`` gets from a parameter
+    file's ``data``, by rcl's rules: every section whose key matches the node, merged in file order;
+    nodes without a matching section are left out. Keys that name no ipfric node are refused."""
+    ns = check_namespace(namespace)
+    found: dict = {}
+    for key, section in data.items():
+        last = str(key).rstrip('/').rsplit('/', 1)[-1]
+        if last not in NODE_NAMES and last not in ('*', '**'):
+            raise ConfigError(f'{path}: unknown section {key!r}; allowed: sections for '
+                              f'{", ".join(NODE_NAMES)} (e.g. /**/sim_node, which matches the node in any '
+                              f'namespace), or /** for all')
+        if not isinstance(section, Mapping) or 'ros__parameters' not in section or not isinstance(
+                section['ros__parameters'], Mapping):
+            raise ConfigError(f'{path}: {key}: {section!r} is not a mapping with ros__parameters:')
+        _one_type_arrays(f'{str(key).lstrip("/")}.ros__parameters', section['ros__parameters'])
+        for node in NODE_NAMES:
+            if key_matches(str(key), f'{ns.rstrip("/")}/{node}'):
+                _merge(found.setdefault(node, {}), section['ros__parameters'])
+    return found
+
+
+def scenario_from_sections(sections: Mapping, path: str | Path = '<scenario>', namespace: str = '/') -> Scenario:
+    """The Scenario of :func:`node_sections`' result (both nodes required, a recorder section checked)."""
+    where = '' if namespace in ('/', '', None) else f' in namespace {namespace}'
     for node in ('sim_node', 'controller_node'):
-        if node not in data:
-            raise ConfigError(f'{path}: missing section {node}: ros__parameters:')
-        sec = data[node]
-        if not isinstance(sec, Mapping) or 'ros__parameters' not in sec:
-            raise ConfigError(f'{path}: {node}: expected a mapping with ros__parameters')
-        sections[node] = sec['ros__parameters']
-    unknown = set(data) - {'sim_node', 'controller_node', 'recorder'}
-    if unknown:
-        raise ConfigError(f'{path}: unknown section(s) {", ".join(sorted(map(str, unknown)))}; allowed: '
-                          f'sim_node, controller_node, recorder')
-    if 'recorder' in data:
-        _check_recorder(path, data['recorder'])
+        if node not in sections:
+            raise ConfigError(f'{path}: no section for {node}{where} (write "{SECTION_KEYS[node]}: ros__parameters:", '
+                              f'which matches the node in any namespace)')
+    if 'recorder' in sections:
+        _check_recorder(path, sections['recorder'])
     return scenario_from_ros_params(sections['sim_node'], sections['controller_node'])
 
 
+def load_scenario(path: str | Path, namespace: str = '/') -> Scenario:
+    """Load a scenario parameter file as the nodes in ``namespace`` read it (both node sections required)."""
+    return scenario_from_sections(node_sections(load_yaml(path), namespace, path), path, namespace)
+
+
+def scenario_path(name: str | Path) -> Path:
+    """A scenario file by path, or by name (``default``, ``fig7_old_gain_exponential.yaml``) among those
+    of the checkout's ``config/`` and those installed in ``share/ipfric_bringup/config`` of every
+    prefix of ``AMENT_PREFIX_PATH``."""
+    p = Path(name)
+    if p.is_file():
+        return p
+    dirs = [REPO_ROOT / 'config'] + [Path(prefix) / 'share' / 'ipfric_bringup' / 'config'
+                                     for prefix in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep) if prefix]
+    if p.name == str(name):
+        for d in dirs:
+            for candidate in (d / p.name, d / f'{p.name}.yaml'):
+                if candidate.is_file() and candidate.name != 'paper.yaml':
+                    return candidate
+    known = sorted({f.stem for d in dirs if d.is_dir() for f in d.glob('*.yaml') if f.name != 'paper.yaml'})
+    raise ConfigError(f'scenario {str(name)!r}: no such file, and no scenario of that name; by name: '
+                      f'{", ".join(known) or "none installed"}')
+
+
 #: The recorder's parameters (ipfric_record.recorder declares them).
-RECORDER_PARAMS = ('output', 'scenario_file')
+RECORDER_PARAMS = ('output', 'scenario_file', 'use_sim_time')
 
 
-def _check_recorder(path, section) -> None:
-    """A ``recorder:`` section: ``ros__parameters`` with known names and string values only."""
-    if not isinstance(section, Mapping) or set(section) != {'ros__parameters'} or not isinstance(
-            section['ros__parameters'], Mapping):
-        raise ConfigError(f'{path}: recorder: {section!r} is not a mapping with ros__parameters: '
-                          f'(parameters {", ".join(RECORDER_PARAMS)})')
-    for key, value in section['ros__parameters'].items():
+def _check_recorder(path, params: Mapping) -> None:
+    """The recorder's ``ros__parameters``: known names, string values (``use_sim_time`` true or false)."""
+    for key, value in params.items():
         if key not in RECORDER_PARAMS:
             near = difflib.get_close_matches(str(key), RECORDER_PARAMS, 1)
             raise ConfigError(f'{path}: recorder.ros__parameters.{key}: unknown parameter'
                               + (f' (did you mean {near[0]!r}?)' if near else '')
                               + f'; allowed: {", ".join(RECORDER_PARAMS)}')
-        if not isinstance(value, str):
+        if key == 'use_sim_time':
+            if not isinstance(value, bool):
+                raise ConfigError(f'{path}: recorder.ros__parameters.use_sim_time: {value!r} is not true or false')
+        elif not isinstance(value, str):
             raise ConfigError(f'{path}: recorder.ros__parameters.{key}: {value!r} is not a string (a path)')

@@ -18,6 +18,7 @@ import math
 import shutil
 from collections.abc import Callable
 from concurrent.futures import as_completed
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -71,8 +72,7 @@ def _ros_cell(scn: Scenario, cell_dir: Path, duration: float):
     if cell_dir.exists():          # a cell interrupted before it reached cells.csv: run it again
         shutil.rmtree(cell_dir)
     cell_dir.mkdir(parents=True)
-    params = scn.to_ros_params()
-    params['sim_node']['ros__parameters']['time_mode'] = 'lockstep'
+    params = replace(scn, sim=replace(scn.sim, time_mode='lockstep')).to_ros_params()
     cfg = cell_dir / 'cell.yaml'
     cfg.write_text(yaml.safe_dump(params, sort_keys=False))
     res = run(cfg, cell_dir / 'run', duration=duration, timeout=60.0 + 2.0 * duration)
