@@ -9,7 +9,7 @@ from conftest import ROOT
 from ipfric_core.analysis.records import load_csv, load_emps, write_csv
 from ipfric_core.cli import main
 from ipfric_core.design.estimation import load_table5, load_table6
-from ipfric_core.ident.equation_error import identify, identify_steady
+from ipfric_core.ident.equation_error import base_fit, identify_steady
 from ipfric_core.ident.excitation import cart_alone_run
 from ipfric_core.ident.redesign import close_the_loop
 from ipfric_core.physics.params import ConfigError, FrictionParams, PlantParams
@@ -25,12 +25,6 @@ FN = PLANT.M * PLANT.g
 @pytest.fixture(scope='module')
 def clean():
     return cart_alone_run(PLANT, TRACK, PlantTruth(), 12.0)
-
-
-def search(rec, base='coulomb'):
-    est, val = rec.split(0.6)
-    res = identify(est, val, base)
-    return res['fit'], res
 
 
 # -- loaders ------------------------------------------------------------------------------
@@ -80,10 +74,9 @@ def test_emps_loader(data_dir):
 
 # -- undeclared effects: the right one is found, nothing on clean data ---------------------
 
-def test_clean_data_gets_no_effect_and_the_declared_parameters(clean):
-    fit, res = search(clean)
-    assert fit.active == ('coulomb',), res['tried']
-    p = fit.params
+def test_the_force_balance_of_clean_data_gives_the_declared_parameters(clean):
+    """The ladder's starter for a record without a plant: the force balance of the law alone."""
+    p = base_fit(clean, 'coulomb').params
     assert p['M'] == pytest.approx(PLANT.M, rel=0.02)
     assert p['eps'] == pytest.approx(TRACK.eps, rel=0.03)
     assert p['Fc'] / FN == pytest.approx(TRACK.mu_c, rel=0.03)
@@ -94,19 +87,24 @@ def test_clean_data_gets_no_effect_and_the_declared_parameters(clean):
 
 @pytest.mark.slow
 def test_emps_beats_the_published_reference_models(data_dir, tmp_path):
+    """EMPS (a real prismatic drive, force input): the ladder adds the direction dependence; the final
+    model runs free over the held-out pulses file closer than both reference models of the benchmark
+    (9.66 mm symmetric with offset, 8.63 mm asymmetric: their published values run free from the same
+    20 readings by an integrator of its own, 10 sub-steps per sample), and its force balance is within
+    the published asymmetric model's 3.11 %; nothing ends on a bound."""
     d = data_dir / 'emps'
-    assert main(['identify', str(d / 'DATA_EMPS.mat'), '--validation', str(d / 'DATA_EMPS_PULSES.mat'),
-                 '--base', 'coulomb', '--effects', 'asymmetry,stribeck,presliding,offset',
+    assert main(['identify', str(d / 'DATA_EMPS.mat'), '--test', str(d / 'DATA_EMPS_PULSES.mat'),
                  '--out', str(tmp_path), '--no-plots']) == 0
     r = json.loads((tmp_path / 'result.json').read_text())
-    assert r['effects_added'][0] == 'asymmetry'
-    before, after = r['error_before'], r['error_after']
-    assert r['simulation_error']['x_percent'] < 5.0     # the force-balance fit also replays the motion
-    assert after['estimation']['relative_percent'] < 3.0   # published: 4.08 symmetric, 3.11 asymmetric
-    assert after['validation']['relative_percent'] < 3.11
-    assert after['validation']['rms'] < 0.5 * before['validation']['rms']
-    assert 94 < r['params']['M']['value'] < 96
-    assert {t['name'] for t in r['effects_tried'] if not t['kept']} <= {'offset', 'presliding', 'stribeck'}
+    assert r['effects_added'] == ['asymmetry'], r['rounds']
+    assert r['test']['rmse_mm'] < 8.63 and r['test']['diverged_samples'] == 0
+    first, last = r['force_error'][0], r['force_error'][-1]
+    assert last['validation']['relative_percent'] < 3.11
+    assert last['validation']['rms'] < 0.5 * first['validation']['rms']
+    final = {p['name']: p for p in r['ladder'][-1]['params']}
+    assert 94 < final['M']['value'] < 96 and final['Fc']['value'] > 15
+    assert not [p['name'] for p in final.values() if p['at_bound'] and p['name'] != 'Fs_excess']
+    assert r['ladder'][-1]['validation']['x_rms_counts'] < r['ladder'][0]['validation']['x_rms_counts']
 
 
 def test_paper_tables_through_the_force_balance(data_dir, paper_cfg):

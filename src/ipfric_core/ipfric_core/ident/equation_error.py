@@ -33,7 +33,7 @@ from ..physics.plant import held_forces, pendulum_residuals, required_forces
 from . import effects as fx
 from .residual import signature_scores
 
-__all__ = ['base_fit', 'force_error', 'signatures_left', 'identify_steady']
+__all__ = ['base_fit', 'structure_fit', 'force_error', 'signatures_left', 'identify_steady']
 
 EDGE_S = 0.15
 TICK_S = 0.02
@@ -284,6 +284,12 @@ def parts(law: str, effects) -> tuple:
     """A model's friction law and effects as the force balance's active parts (a drive with play has a
     hidden state the balance cannot express: left out)."""
     return fx.BASE_MODELS[law] + tuple(e for e in effects if fx.EFFECTS[e].acts_on != 'drive')
+
+
+def structure_fit(rec: Record, p: dict, law: str, effects) -> Fit:
+    """The force balance of a model's structure (its friction law and effects: :func:`parts`) fitted to
+    ``rec`` from the model's values ``p``: the mass, the law's levels and the effects' parameters."""
+    return fit(Prepared(rec), parts(law, effects), p)
 
 
 def force_error(rec: Record, p: dict, law: str, effects) -> dict:

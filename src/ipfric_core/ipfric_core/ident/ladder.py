@@ -4,11 +4,14 @@ The declared model (plant constants and friction law with their values) is the
 hypothesis. The ladder, on one metric (the multiple-shooting simulation error of
 :mod:`ipfric_core.ident.shooting`, in encoder counts):
 
-(a) the declared model as it is;
-(b) its friction refitted (known constants frozen unless freed by name); a large change of a
-    declared value is reported as evidence of a missing effect;
-(c) effects of the library added one at a time, each round the one that lowers the
-    validation error most among those that pass every check:
+the declared model as it is; then, round by round until the validation error is within
+reach of what the encoders' rounding alone leaves (:func:`verdict`) or nothing passes, every
+hypothesis competes against the current model (:func:`hypotheses`): its friction refitted
+(known constants frozen unless freed by name: a freed one is fitted first, whatever the
+verdict), each other friction law (viscous, coulomb, exponential, dynamic with its bristle
+starts), each plant correction (M, alpha, beta), each library effect with the friction levels
+refitted and, before any refit, on the declared friction alone. A round keeps the one that
+lowers the validation error most among those that pass every check:
 
 - it lowers the validation simulation error by more than ``SIM_GAIN_PERCENT``, significantly
   (block bootstrap over the validation windows, p < ``P_VALUE``), and the estimation error
@@ -48,7 +51,7 @@ from . import lsq, shooting
 from .effects import EFFECTS, PARAMS
 from .model import FRICTION_FITTED, LADDER_EFFECTS, LAW_PARAMS, Model
 
-__all__ = ['Problem', 'Step', 'run_ladder']
+__all__ = ['Problem', 'Step', 'run_ladder', 'verdict']
 
 P_VALUE = 0.01           # a drop is significant below this p-value
 BOOTSTRAP = 2000         # resamples of the windows' drops (:func:`block_p_value`)
@@ -254,7 +257,7 @@ def block_covariance(pr: Problem, model: Model, jac: np.ndarray, fun: np.ndarray
     bread = np.linalg.pinv(jac.T @ jac)
     meat = np.zeros_like(bread)
     o = 0
-    for (_, win, wt), nb in zip(pr.blocks, rows):
+    for (_, win, _), nb in zip(pr.blocks, rows):
         r, j = fun[o:o + nb], jac[o:o + nb]
         meat += float(r @ r) / max(1, len(win)) * (j.T @ j)
         o += nb
@@ -611,11 +614,19 @@ def errors_of(pe: Problem, h: Hypothesis, model: Model, prior: Model) -> dict:
                      profile=set(SIZE.get(h.effect or '', ())) | set(h.own))[1]
 
 
+#: parameters whose lower bound is the simpler law itself, not a limit of physics: static friction no
+#: higher than the Coulomb level is Coulomb friction without stiction (the data saw no sticking)
+NESTED_AT_LOWER = ('Fs_excess',)
+
+
 def on_bounds(model: Model) -> list[str]:
     """Why a fitted parameter of ``model`` refutes it: it ends on a bound of its range (a bound reached
-    means the law or the effect is refuted there)."""
+    means the law or the effect is refuted there); but for :data:`NESTED_AT_LOWER` at their lower one."""
+    def refutes(p) -> bool:
+        tol = 1e-3 * PARAMS[p.name].typical
+        return p.at_bound(tol) and not (p.name in NESTED_AT_LOWER and p.value - p.lo <= tol)
     return [f'{p.name} = {p.value:.4g} {p.unit} ends on its bound [{p.lo:g}, {p.hi:g}]'
-            for p in model.free if p.at_bound(1e-3 * PARAMS[p.name].typical)]
+            for p in model.free if refutes(p)]
 
 
 def untold(model: Model, std: dict) -> list[str]:

@@ -152,10 +152,12 @@ class Model:
         """The friction law with its fitted values as coefficients (F_N = normal_force)."""
         fn = self.normal_force
         fc = self.get('Fc')
-        bristle = {k: self[k] for k in ('sigma0', 'sigma1')} if self.law == 'dynamic' else {}
+        bristle = self.law == 'dynamic'
+        base = FrictionParams()
         return FrictionParams(model=self.law, eps=self['eps'], mu_c=fc / fn,
                               mu_s=(fc + self.get('Fs_excess')) / fn, v_s=self.get('v_s', 0.105),
-                              gamma=self.gamma, **bristle)
+                              gamma=self.gamma, sigma0=self['sigma0'] if bristle else base.sigma0,
+                              sigma1=self['sigma1'] if bristle else base.sigma1)
 
     def plant_params(self) -> PlantParams:
         return PlantParams(M=self['M'], m=max(self['m'], 1e-6), l=self['l'], g=self.g,

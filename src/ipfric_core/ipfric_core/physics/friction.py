@@ -37,7 +37,7 @@ from .compiled import compiled
 from .params import FrictionParams
 
 __all__ = ['DYNAMIC', 'FP_MODEL', 'FP_EPS', 'FP_SIGMA0', 'FP_SIGMA1', 'FP_ASYM', 'friction_vector', 'sticks',
-           'static_limit', 'holding_margin', 'holds', 'sliding_level', 'friction_force', 'bristle_rate',
+           'static_limit', 'holding_margin', 'holds', 'sliding_level', 'bristle_level', 'friction_force', 'bristle_rate',
            'friction_forces', 'bristle_path', 'Friction']
 
 #: Codes of the friction models in a parameter vector (floats, so the vector is uniform).
@@ -112,6 +112,17 @@ def sliding_level(fp, v: float) -> float:
     return stribeck_level(v, fp[FP_MU_S], fp[FP_MU_C], fp[FP_V_S], fp[FP_GAMMA], fp[FP_FN])
 
 
+#: the least Stribeck level the bristle equations divide by [N] (a law without any level has bristles
+#: that carry no force; the floor keeps eqs. (10)-(11) defined there)
+MIN_BRISTLE_LEVEL = 1e-9
+
+
+@compiled
+def bristle_level(fp, v: float) -> float:
+    """g(v) of the dynamic law's bristle equations [N]: :func:`sliding_level`, at least MIN_BRISTLE_LEVEL."""
+    return max(sliding_level(fp, v), MIN_BRISTLE_LEVEL)
+
+
 @compiled
 def friction_force(fp, v: float, z: float, direction: float) -> float:
     """Friction force on the moving cart [N], eqs. (3), (6)-(8), (11).
@@ -124,7 +135,7 @@ def friction_force(fp, v: float, z: float, direction: float) -> float:
     if model == VISCOUS:
         return viscous
     if model == DYNAMIC:
-        return viscous - fp[FP_SIGMA1] * v - fp[FP_SIGMA0] * z * (1.0 - fp[FP_SIGMA1] * abs(v) / sliding_level(fp, v))
+        return viscous - fp[FP_SIGMA1] * v - fp[FP_SIGMA0] * z * (1.0 - fp[FP_SIGMA1] * abs(v) / bristle_level(fp, v))
     if fp[FP_SMOOTH] != 0.0:
         sign = math.tanh(fp[FP_DELTA] * v)
     elif direction != 0.0:
@@ -139,7 +150,7 @@ def bristle_rate(fp, v: float, z: float) -> float:
     """Bristle deflection rate z' [m/s], eq. (10); 0 for the other laws."""
     if fp[FP_MODEL] != DYNAMIC:
         return 0.0
-    return v - fp[FP_SIGMA0] * abs(v) * z / sliding_level(fp, v)
+    return v - fp[FP_SIGMA0] * abs(v) * z / bristle_level(fp, v)
 
 
 @compiled
@@ -163,7 +174,7 @@ def bristle_path(fp, v, dt: float):
     zk = 0.0
     for k in range(len(v)):
         if v[k] != 0.0:
-            a = fp[FP_SIGMA0] * abs(v[k]) / sliding_level(fp, v[k])
+            a = fp[FP_SIGMA0] * abs(v[k]) / bristle_level(fp, v[k])
             zss = v[k] / a
             zk = zss + (zk - zss) * math.exp(-a * dt)
         z[k] = zk

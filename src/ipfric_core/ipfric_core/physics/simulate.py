@@ -33,7 +33,7 @@ from .friction import (
     friction_force,
     holding_margin,
     holds,
-    sliding_level,
+    bristle_level,
     sticks,
 )
 from .plant import (
@@ -210,7 +210,7 @@ def bristle_step(pp, fp, v: float, h: float) -> float:
     if fp[FP_MODEL] != DYNAMIC:
         return h
     step = min(h, 2.0 * math.pi * math.sqrt(pp[0] / fp[FP_SIGMA0]) / CONTACT_STEPS)
-    rate = max(fp[FP_SIGMA0] * abs(v) / sliding_level(fp, v), (fp[FP_SIGMA1] + fp[FP_EPS]) / pp[0])
+    rate = max(fp[FP_SIGMA0] * abs(v) / bristle_level(fp, v), (fp[FP_SIGMA1] + fp[FP_EPS]) / pp[0])
     if rate * step > 1.0:
         step = 1.0 / rate
     return max(step, h / MAX_BRISTLE_STEPS)
