@@ -37,8 +37,8 @@ from .compiled import compiled
 from .params import FrictionParams
 
 __all__ = ['DYNAMIC', 'FP_MODEL', 'FP_EPS', 'FP_SIGMA0', 'FP_SIGMA1', 'FP_ASYM', 'friction_vector', 'sticks',
-           'static_limit', 'holding_margin', 'holds', 'sliding_level', 'bristle_level', 'friction_force', 'bristle_rate',
-           'friction_forces', 'bristle_path', 'Friction']
+           'static_limit', 'holding_margin', 'holds', 'sliding_level', 'bristle_level', 'friction_force',
+           'bristle_rate', 'friction_forces', 'bristle_path', 'Friction']
 
 #: Codes of the friction models in a parameter vector (floats, so the vector is uniform).
 MODEL_CODES = {'viscous': 0.0, 'coulomb': 1.0, 'exponential': 2.0, 'dynamic': 3.0}

@@ -30,10 +30,10 @@ from .friction import (
     FP_MODEL,
     FP_SIGMA0,
     FP_SIGMA1,
+    bristle_level,
     friction_force,
     holding_margin,
     holds,
-    bristle_level,
     sticks,
 )
 from .plant import (
