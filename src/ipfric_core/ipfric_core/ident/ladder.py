@@ -603,8 +603,15 @@ def joint(h: Hypothesis, model: Model) -> set:
 
 def full_fit(pe: Problem, h: Hypothesis, best: Model, prior: Model) -> Model:
     """The fit of the hypothesis's parameters with every parameter the model already fits (:func:`joint`),
-    from its short fit ``best``."""
-    return fit_model(pe, best, only=joint(h, best), prior=prior, errors=False)[0]
+    from its short fit ``best``. A refit of the declared law that puts one of its levels on a bound is
+    done again with that level held at its declared value: the data did not determine it (below the
+    Stribeck velocity the Coulomb level and the curve's width trade), and a bound is no answer."""
+    m = fit_model(pe, best, only=joint(h, best), prior=prior, errors=False)[0]
+    if h.kind == 'friction':
+        held = {p.name: prior[p.name] for p in bound_params(m) if p.name in LAW_PARAMS[m.law]}
+        if held:
+            m = fit_model(pe, m.holding(held), only=joint(h, best) - set(held), prior=prior, errors=False)[0]
+    return m
 
 
 def errors_of(pe: Problem, h: Hypothesis, model: Model, prior: Model) -> dict:
@@ -619,14 +626,19 @@ def errors_of(pe: Problem, h: Hypothesis, model: Model, prior: Model) -> dict:
 NESTED_AT_LOWER = ('Fs_excess',)
 
 
-def on_bounds(model: Model) -> list[str]:
-    """Why a fitted parameter of ``model`` refutes it: it ends on a bound of its range (a bound reached
-    means the law or the effect is refuted there); but for :data:`NESTED_AT_LOWER` at their lower one."""
+def bound_params(model: Model) -> list:
+    """The fitted parameters of ``model`` that end on a bound of their range; but for
+    :data:`NESTED_AT_LOWER` at their lower one."""
     def refutes(p) -> bool:
         tol = 1e-3 * PARAMS[p.name].typical
         return p.at_bound(tol) and not (p.name in NESTED_AT_LOWER and p.value - p.lo <= tol)
-    return [f'{p.name} = {p.value:.4g} {p.unit} ends on its bound [{p.lo:g}, {p.hi:g}]'
-            for p in model.free if refutes(p)]
+    return [p for p in model.free if refutes(p)]
+
+
+def on_bounds(model: Model) -> list[str]:
+    """Why a fitted parameter of ``model`` refutes it: it ends on a bound of its range (a bound reached
+    means the law or the effect is refuted there; :func:`bound_params`)."""
+    return [f'{p.name} = {p.value:.4g} {p.unit} ends on its bound [{p.lo:g}, {p.hi:g}]' for p in bound_params(model)]
 
 
 def untold(model: Model, std: dict) -> list[str]:
@@ -857,6 +869,9 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
         label = {'friction': 'refit', 'law': win.h.label, 'plant': win.h.label}.get(win.h.kind, f'+ {win.h.effect}')
         step_notes = correction_notes(declared, current, s) if win.h.kind == 'plant' else []
         step_notes += refit_notes(declared, current) if win.h.kind in ('friction', 'law', 'plant') else []
+        step_notes += [f'{p.name} held at its declared {p.value:.4g} {p.unit}: the refit put it on a bound, the data '
+                       'do not determine it' for p in current.params
+                       if win.h.kind == 'friction' and p.name in LAW_PARAMS[current.law] and not p.free]
         steps.append(Step(label, current, s, pe.summary(current), pv.summary(current), step_notes))
         rounds.append({'round': round_no, 'kept': win.h.label,
                        'runner_up': _alternative(runner, pv) if runner else None})

@@ -122,6 +122,11 @@ class Model:
         """This model with the parameters ``names`` fitted (the others as they are)."""
         return replace(self, params=tuple(replace(p, free=True) if p.name in names else p for p in self.params))
 
+    def holding(self, values: dict) -> Model:
+        """This model with the parameters of ``values`` held there (not fitted)."""
+        return replace(self, params=tuple(replace(p, value=float(values[p.name]), free=False) if p.name in values
+                                          else p for p in self.params))
+
     def with_bounds(self, name: str, lo: float, hi: float) -> Model:
         """This model with parameter ``name`` confined to [lo, hi] (within its physical range)."""
         return replace(self, params=tuple(replace(p, lo=max(p.lo, lo), hi=min(p.hi, hi)) if p.name == name else p
