@@ -107,3 +107,10 @@ def test_command_writes_summary_runs_and_histogram(tmp_path, capsys):
 def test_bad_input_names_the_field(args, field, tmp_path, capsys):
     assert main(['montecarlo', *args, '--out', str(tmp_path)]) == 2
     assert field in capsys.readouterr().err
+
+
+def test_a_file_for_out_is_refused_before_any_work(tmp_path, capsys):
+    f = tmp_path / 'mc'
+    f.write_text('x')
+    assert main(['montecarlo', '--spread', 'mu_s=0.3', '--runs', '2', '--out', str(f)]) == 2
+    assert f'--out: {f} is a file; allowed: a directory (new or existing)' in capsys.readouterr().err

@@ -10,7 +10,7 @@ from ..physics.params import ConfigError
 from ..run.scenario import DEFAULT_SCENARIO
 from ..study.montecarlo import DISTRIBUTIONS, montecarlo_study, spread_draws
 from ..study.variants import SENSORS, load_variant
-from .output import print_json, progress_counter
+from .output import output_dir, print_json, progress_counter
 
 __all__ = ['NAME', 'HELP', 'add_arguments', 'main']
 
@@ -48,6 +48,7 @@ def main(args) -> int:
     if (args.spread is None) == (args.from_ident is None):
         raise ConfigError('give either --spread NAME=S,... (relative spreads) or --from-ident DIR (an '
                           'identification\'s parameter table)')
+    output_dir(args.out)
     base = load_variant(args.config, args.sensors)
     draw, drawn = (spread_draws(base, args.spread, args.seed, args.distribution) if args.spread is not None
                    else report_draws(args.from_ident, base, args.seed))
