@@ -24,7 +24,8 @@ def add_arguments(mc) -> None:
     mc.add_argument('--config', default=str(DEFAULT_SCENARIO),
                     help='scenario whose parameters are drawn (default %(default)s)')
     mc.add_argument('--runs', type=int, default=1000, help='number of runs (default %(default)s)')
-    mc.add_argument('--duration', type=float, default=20.0, help='simulated seconds per run (default %(default)s; at least 10 samples, at most 1e6 s)')
+    mc.add_argument('--duration', type=float, default=20.0,
+                    help='simulated seconds per run (default %(default)s; at least 10 samples, at most 1e6 s)')
     mc.add_argument('--spread', metavar='NAME=S,...',
                     help='relative 1-sigma spreads of plant or friction coefficients, e.g. mu_s=0.3,mu_c=0.3,eps=0.3 '
                          '(30 %%); each value = nominal * (1 + S z), clipped to its range, mu_c <= mu_s')

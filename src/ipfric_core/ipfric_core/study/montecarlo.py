@@ -31,7 +31,8 @@ from ..run.scenario import SIM_FIELDS, Scenario
 from .executor import make_executor
 from .outcome import classify_run, true_p2p
 
-__all__ = ['DISTRIBUTIONS', 'MAX_SEED', 'MIN_RUN_SAMPLES', 'check_seed', 'check_duration', 'parse_spread', 'spread_draw', 'run_chunk', 'run_montecarlo', 'spread_draws',
+__all__ = ['DISTRIBUTIONS', 'MAX_SEED', 'MIN_RUN_SAMPLES', 'check_seed', 'check_duration', 'parse_spread',
+           'spread_draw', 'run_chunk', 'run_montecarlo', 'spread_draws',
            'montecarlo_study']
 
 #: how a relative spread s turns into a factor on the nominal value
