@@ -9,6 +9,7 @@ from ..ident.uncertainty import report_draws
 from ..physics.params import ConfigError
 from ..run.scenario import DEFAULT_SCENARIO
 from ..study.montecarlo import DISTRIBUTIONS, check_duration, check_seed, montecarlo_study, spread_draws
+from ..study.executor import scheduler_address
 from ..study.variants import SENSORS, load_variant
 from .output import output_dir, print_json, progress_counter
 
@@ -51,6 +52,8 @@ def main(args) -> int:
                           'identification\'s parameter table)')
     output_dir(args.out)
     check_seed(args.seed)
+    if args.scheduler:
+        scheduler_address(args.scheduler)
     base = load_variant(args.config, args.sensors)
     check_duration(args.duration, base)
     draw, drawn = (spread_draws(base, args.spread, args.seed, args.distribution) if args.spread is not None

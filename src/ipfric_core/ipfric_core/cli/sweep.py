@@ -8,6 +8,7 @@ import sys
 
 from ..constants import REPO_ROOT
 from ..physics.params import ConfigError
+from ..study.executor import scheduler_address
 from ..study.sweep import figure_study, map_study, parse_range, resolution_report, threshold_report
 from ..study.variants import FIGURES, SCALED_SENSORS, SENSORS
 from .output import output_dir, print_json, progress_counter
@@ -112,6 +113,8 @@ def figure(args, taus, progress) -> int:
 
 def main(args) -> int:
     output_dir(args.out)
+    if args.scheduler:
+        scheduler_address(args.scheduler)
     if args.ros and args.scheduler:
         raise ConfigError('--ros with --scheduler: a ROS cell runs three node processes on this machine; '
                           'drop one of them')

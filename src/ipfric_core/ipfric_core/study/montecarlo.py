@@ -28,7 +28,7 @@ from ..analysis.oscillation import CLASSES
 from ..analysis.plots import CLASS_COLOURS, save_figure
 from ..physics.params import FRICTION_FIELDS, PLANT_FIELDS, ConfigError, Field
 from ..run.scenario import SIM_FIELDS, Scenario
-from .executor import make_executor
+from .executor import make_executor, scheduler_address
 from .outcome import classify_run, true_p2p
 
 __all__ = ['DISTRIBUTIONS', 'MAX_SEED', 'MIN_RUN_SAMPLES', 'check_seed', 'check_duration', 'parse_spread',
@@ -212,6 +212,8 @@ def montecarlo_study(draw: Callable[[int], tuple[dict, Scenario]], info: dict, r
         raise ConfigError(f'--duration: {duration!r} must be > 0 s')
     if workers is not None and workers < 1:
         raise ConfigError(f'--workers: {workers} must be >= 1')
+    if scheduler:
+        scheduler_address(scheduler)
     rows = run_montecarlo(draw, runs, duration, workers, scheduler, progress)
     return write_results(rows, {**info, 'runs': runs, 'duration_s': duration}, out, title)
 

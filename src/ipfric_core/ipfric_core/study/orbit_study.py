@@ -22,7 +22,7 @@ from ..run.scenario import CONTROLLER_FIELDS, Scenario
 from .basin import Edge, basin_edge, shape_threshold
 from .bifurcation import diagram
 from .continuation import parse_continuation, trace, unstable_partners
-from .executor import make_executor
+from .executor import make_executor, scheduler_address
 from .orbit import OrbitError, find_orbit, simulated_cycle
 from .variants import PARAMETERS, loop_of, scenario_at
 
@@ -158,6 +158,8 @@ def orbit_study(base: Scenario, out: str | Path, delay: float | None = None, bas
     """Everything ``./ipfric orbit`` reports on ``base`` (see the module docstring), written to
     ``out/orbit.json`` after ``info``; ``basin``: 'LO,HI' [rad], ``cont``: 'NAME=START:STOP[:POINTS]'."""
     continuation = continuation_of(cont) if cont else None
+    if scheduler:
+        scheduler_address(scheduler)
     bracket = basin_bracket(basin, duration) if basin else None
     if bracket:
         check_run_length('--duration', duration, base)
