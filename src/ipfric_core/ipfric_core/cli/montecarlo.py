@@ -8,8 +8,8 @@ from pathlib import Path
 from ..ident.uncertainty import report_draws
 from ..physics.params import ConfigError
 from ..run.scenario import DEFAULT_SCENARIO
-from ..study.montecarlo import DISTRIBUTIONS, check_duration, check_seed, montecarlo_study, spread_draws
 from ..study.executor import scheduler_address
+from ..study.montecarlo import DISTRIBUTIONS, check_duration, check_seed, montecarlo_study, spread_draws
 from ..study.variants import SENSORS, load_variant
 from .output import output_dir, print_json, progress_counter
 

@@ -65,8 +65,8 @@ def make_executor(scheduler: str | None = None, workers: int | None = None,
         socket.create_connection((host, port), timeout=timeout).close()
     except OSError as exc:
         raise SchedulerError(f'--scheduler {scheduler}: no Dask scheduler answers at {host}:{port} within '
-                             f'{timeout:g} s ({exc.strerror or type(exc).__name__}); start one with `dask scheduler` and give '
-                             f'its address, e.g. tcp://HOST:8786') from None
+                             f'{timeout:g} s ({exc.strerror or type(exc).__name__}); start one with `dask scheduler` '
+                             f'and give its address, e.g. tcp://HOST:8786') from None
     from distributed import Client
     try:
         client = Client(scheduler, timeout=timeout, set_as_default=False)
