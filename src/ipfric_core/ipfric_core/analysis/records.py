@@ -377,7 +377,7 @@ def _text_lines(path: Path):
         raw: IO[bytes] = path.open('rb')
     except OSError as exc:
         raise ConfigError(f'{path}: cannot read ({exc.strerror})') from exc
-    data: IO[bytes] = gzip.GzipFile(fileobj=raw) if path.suffix.lower() == '.gz' else raw
+    data: IO[bytes] | gzip.GzipFile = gzip.GzipFile(fileobj=raw) if path.suffix.lower() == '.gz' else raw
     try:
         for lineno, line in enumerate(data, 1):   # decoded line by line: an error names its line and column
             if lineno == 1 and line.startswith(codecs.BOM_UTF8):
@@ -463,8 +463,13 @@ def load_bag(path: str | Path, plant: PlantParams | None = None, cart_alone: boo
     from .bagread import read_run
     run = read_run(path)
     if plant is None:
+        if run.truncated and not run.config:
+            raise ConfigError(f'{path}: the bag is truncated ({run.truncation_detail}): its scenario, stored at the '
+                              f'end of the file with the summary, is cut off, so the plant constants are missing; '
+                              f'give them with --plant')
         if not run.config or 'plant' not in run.config:
-            raise ConfigError(f'{path}: the bag stores no scenario; give the plant constants with --plant')
+            raise ConfigError(f'{path}: the bag stores no scenario (no plant section); give the plant constants '
+                              f'with --plant')
         plant = PlantParams.from_dict(run.config['plant'], 'bag scenario plant')
     k = np.searchsorted(run.t, run.command_t)
     ok = (k < len(run.t)) & (np.abs(run.t[np.minimum(k, len(run.t) - 1)] - run.command_t) < 1e-6)
