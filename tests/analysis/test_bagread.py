@@ -153,3 +153,13 @@ def test_a_file_that_is_not_mcap_is_refused_with_exit_2(tmp_path, capsys, conten
         read_run(tmp_path / 'x.mcap')
     assert main(['analyze', '--no-plots', str(tmp_path / 'x.mcap')]) == 2
     assert phrase in capsys.readouterr().err
+
+
+def test_identify_on_a_cut_bag_says_it_is_cut_and_what_is_missing(tmp_path, capsys):
+    write_bag(tmp_path / 'run.mcap', 300)
+    data = (tmp_path / 'run.mcap').read_bytes()
+    (tmp_path / 'cut.mcap').write_bytes(data[:len(data) // 2])
+    assert main(['identify', str(tmp_path / 'cut.mcap'), '--out', str(tmp_path / 'out'), '--no-plots']) == 2
+    err = capsys.readouterr().err
+    assert 'the bag is truncated (' in err and 'its scenario' in err and 'is cut off' in err, err
+    assert 'plant constants are missing' in err and '--plant' in err and 'Traceback' not in err

@@ -41,6 +41,15 @@ REFUSED = [
     ('angle in degrees', 'deg.csv', table(theta=15.0 + 5.0 * np.sin(np.arange(N) * 1e-2)), 'degrees?'),
     # (a constant angle column is a removed pendulum: tests/analysis/test_records.py::test_constant_angle)
     ('no such file', 'missing.csv', None, 'cannot read'),
+    ('bad byte on line 52', 'latin1.csv', ('\n'.join(ROWS[:51]) + '\n').encode() + b'0.05,0\xe9,1\n'
+     + ('\n'.join(ROWS[52:]) + '\n').encode(), 'line 52, byte column 7: byte 0xe9 is not UTF-8'),
+    ('one 9.5 m row', 'spike.csv', '\n'.join(ROWS[:199] + ['0.198,9.5,0.5'] + ROWS[200:]) + '\n',
+     'column x jumps from'),
+    ('999 V on a 10 V drive', 'volt.csv', '\n'.join(ROWS[:99] + ['0.098,0,999'] + ROWS[100:]) + '\n',
+     'column voltage is 999 at row 99; allowed |voltage| <= 100 V'),
+    ('time in minutes', 'min.csv', table(t=np.arange(N) * 1e-3 / 60), 'is t in minutes?'),
+    ('underscore in a number', 'under.csv', '\n'.join(ROWS[:9] + ['0.008,0,1_0.5'] + ROWS[10:]) + '\n',
+     "row 10, column 'voltage': '1_0.5' is not a number"),
 ]
 
 

@@ -101,3 +101,24 @@ def test_columns_angle_zero_and_bad_input(tmp_path, capsys):
                delimiter=',', header='t,x,voltage', comments='')
     code, err = analyse(capsys, tmp_path / 'cart.csv')
     assert code == 2 and 'no pendulum angle' in err and '--columns theta=NAME' in err
+
+
+@pytest.mark.parametrize('args, words', [
+    (['--max-angle-deg', '-5'], ['--max-angle-deg', '-5.0', '(0, 90] deg']),
+    (['--max-angle-deg', 'nan'], ['--max-angle-deg', 'nan', '(0, 90] deg']),
+    (['--max-angle-deg', '400'], ['--max-angle-deg', '400.0', '(0, 90] deg']),
+    (['--min-balanced-s', '-1'], ['--min-balanced-s', '-1.0', '(0, 1e+06] s']),
+    (['--min-balanced-s', 'inf'], ['--min-balanced-s', 'inf']),
+])
+def test_bad_thresholds_name_the_option_and_range(args, words, tmp_path, capsys):
+    rig_log(tmp_path / 'rig.csv', 1)
+    code, err = analyse(capsys, tmp_path / 'rig.csv', *args)
+    assert code == 2 and all(w in err for w in words), err
+
+
+def test_a_file_for_plots_is_refused(tmp_path, capsys):
+    rig_log(tmp_path / 'rig.csv', 1)
+    f = tmp_path / 'plots'
+    f.write_text('x')
+    assert main(['analyze', str(tmp_path / 'rig.csv'), '--plots', str(f)]) == 2
+    assert f'--plots: {f} is a file; allowed: a directory (new or existing)' in capsys.readouterr().err

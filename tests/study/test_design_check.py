@@ -123,3 +123,11 @@ def test_a_floor_needs_the_viscous_loop_to_rest():
     # delay 20 ms beyond the sliding tau_c of the new gain (15.4 ms): it hunts with exact sensors too
     tau20 = load_scenario(ROOT / 'config' / 'delay_exponential_tau20ms.yaml')
     assert settled_cycle(exact_loop(viscous(tau20)))['behaviour'] == 'hunts'
+
+
+def test_a_file_for_out_is_refused_before_any_work(tmp_path, capsys):
+    f = tmp_path / 'page'
+    f.write_text('x')
+    assert main(['design', '--check', '--out', str(f)]) == 2
+    err = capsys.readouterr().err
+    assert f'--out: {f} is a file; allowed: a directory (new or existing)' in err and '[design --check]' not in err

@@ -107,3 +107,60 @@ def test_command_writes_summary_runs_and_histogram(tmp_path, capsys):
 def test_bad_input_names_the_field(args, field, tmp_path, capsys):
     assert main(['montecarlo', *args, '--out', str(tmp_path)]) == 2
     assert field in capsys.readouterr().err
+
+
+def test_a_file_for_out_is_refused_before_any_work(tmp_path, capsys):
+    f = tmp_path / 'mc'
+    f.write_text('x')
+    assert main(['montecarlo', '--spread', 'mu_s=0.3', '--runs', '2', '--out', str(f)]) == 2
+    assert f'--out: {f} is a file; allowed: a directory (new or existing)' in capsys.readouterr().err
+
+
+@pytest.mark.parametrize('args, words', [
+    (['--seed', '-1'], ['--seed', '-1', '0 .. 4294967295']),
+    (['--seed', str(2**32)], ['--seed', '4294967296', '0 .. 4294967295']),
+    (['--duration', '1e-9'], ['--duration', '1e-09', 'allowed 0.01 .. 1e+06 s', '10 samples']),
+    (['--duration', 'nan'], ['--duration', 'nan']),
+])
+def test_bad_seed_and_duration_are_refused_with_the_range(args, words, tmp_path, capsys):
+    assert main(['montecarlo', '--spread', 'mu_s=0.3', '--runs', '2', *args, '--out', str(tmp_path / 'o')]) == 2
+    err = capsys.readouterr().err
+    assert all(w in err for w in words), err
+    assert not (tmp_path / 'o').exists()
+
+
+def _broken(result: dict, change: str) -> None:
+    if change == 'no ladder':
+        del result['ladder']
+    elif change == 'empty ladder':
+        result['ladder'] = []
+    elif change == 'no plant':
+        del result['identified']['plant']
+    elif change == 'dt 0':
+        result['data']['sample_period_s'] = 0
+    elif change == 'M negative':
+        result['identified']['plant']['M'] = -0.8
+    elif change == 'nan param':
+        result['ladder'][-1]['params'][2]['value'] = float('nan')
+    elif change == 'no data':
+        del result['data']
+
+
+@pytest.mark.parametrize('change, words', [
+    ('no ladder', ['no ladder']),
+    ('empty ladder', ['ladder is empty']),
+    ('no plant', ['identified.plant is missing']),
+    ('dt 0', ['data.sample_period_s 0 is invalid', '(0, 1] s']),
+    ('M negative', ['identified.plant.M', '-0.8', '(0, 1000] kg']),
+    ('nan param', ['ladder parameter l = nan', 'allowed']),
+    ('no data', ['data section is missing']),
+])
+def test_a_broken_identification_is_refused_naming_file_and_field(change, words, tmp_path, capsys):
+    folder = identification(tmp_path / 'ident')
+    result = json.loads((folder / 'result.json').read_text())
+    _broken(result, change)
+    (folder / 'result.json').write_text(json.dumps(result))
+    assert main(['montecarlo', '--from-ident', str(folder), '--runs', '2', '--out', str(tmp_path / 'o')]) == 2
+    err = capsys.readouterr().err
+    assert str(folder / 'result.json') in err and all(w in err for w in words), err
+    assert 'Traceback' not in err

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 from dataclasses import replace
@@ -9,6 +10,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from ipfric_core.cli import main
 from ipfric_core.run.scenario import load_scenario
 from ipfric_core.study.continuation import parse_continuation, trace, unstable_partners
 from ipfric_core.study.orbit import find_orbit, loop_numbers, return_map, simulated_cycle
@@ -136,3 +138,31 @@ def test_cli_writes_orbit_branch_and_diagram(tmp_path):
     assert len(rows) >= 3 and rows[0].startswith('parameter,branch,x_p2p_m')
     assert (tmp_path / 'bifurcation.png').stat().st_size > 10_000
     assert np.isfinite(o['period_s'])
+
+
+@pytest.mark.parametrize('args, words', [
+    (['--continue', 'delay=0:0.02:1000000000'], ['--continue', 'POINTS 1000000000', '2 .. 2000']),
+    (['--continue', 'friction=-1:1'], ['--continue', 'negative friction scale', '>= 0']),
+    (['--continue', 'delay=0:50'], ['--continue', 'delays out of range', '[0, 10] s']),
+    (['--delay', '1e9'], ['--delay', '1e+09', '[0, 10] s']),
+    (['--simulate', '1e12'], ['--simulate', '1000000000000.0', '0 .. 2000 s', '2000000 samples']),
+    (['--simulate', '-1'], ['--simulate', '-1.0', '0 .. 2000 s']),
+    (['--basin', '0.001,0.05', '--duration', '1e9'], ['--duration', '2000 s']),
+    (['--cutoff-hz', '1e9'], ['--cutoff-hz', '1e+09', '[0, 10000] Hz']),
+])
+def test_cli_refuses_out_of_range_options_before_any_work(args, words, tmp_path, capsys):
+    assert main(['orbit', *args, '--out', str(tmp_path / 'o')]) == 2
+    err = capsys.readouterr().err
+    assert all(w in err for w in words), err
+    assert 'Traceback' not in err and not (tmp_path / 'o').exists()
+
+
+def test_cli_refuses_a_file_for_out_and_a_fifo_for_config(tmp_path, capsys):
+    f = tmp_path / 'f'
+    f.write_text('x')
+    assert main(['orbit', '--out', str(f)]) == 2
+    assert f'--out: {f} is a file; allowed: a directory (new or existing)' in capsys.readouterr().err
+    fifo = tmp_path / 'fifo'
+    os.mkfifo(fifo)
+    assert main(['orbit', '--config', str(fifo), '--out', str(tmp_path / 'o')]) == 2
+    assert f'{fifo}: not a regular file' in capsys.readouterr().err

@@ -1,5 +1,6 @@
 """Runs on a Dask cluster give the rows of the local process pool; a dead scheduler is a clear error."""
 import socket
+import time
 from pathlib import Path
 
 import numpy as np
@@ -91,3 +92,26 @@ def test_unreachable_scheduler_is_a_clear_error(tmp_path, capsys):
                  '--out', str(tmp_path / 'orbit')])
     assert code == 2
     assert f'--scheduler {address}' in capsys.readouterr().err
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize('address', ['notahost:xx', 'tcp://', 'http://10.0.0.5:8786', 'tcp://h:99999', 'tcp://a b'])
+def test_a_malformed_scheduler_address_is_refused_before_any_work(address, tmp_path, capsys):
+    for argv in (['montecarlo', '--spread', 'mu_s=0.3', '--runs', '2'],
+                 ['sweep', '--tau', '0', '--theta0-deg', '1', '--duration', '1'],
+                 ['orbit', '--continue', 'delay=0:0.002:3', '--simulate', '0']):
+        code = main([*argv, '--scheduler', address, '--out', str(tmp_path / 'out')])
+        err = capsys.readouterr().err
+        assert code == 2 and f'--scheduler: {address!r} is not a scheduler address' in err, err
+        assert 'HOST[:PORT] with PORT 1..65535' in err and 'Traceback' not in err
+        assert not (tmp_path / 'out').exists()
+
+
+@pytest.mark.timeout(30)
+def test_a_refused_connection_ends_at_once_in_one_line(tmp_path, capsys):
+    address = f'127.0.0.1:{free_port()}'
+    t0 = time.monotonic()
+    assert main(['montecarlo', '--spread', 'mu_s=0.3', '--runs', '2', '--duration', '1', '--scheduler', address,
+                 '--out', str(tmp_path / 'out')]) == 2
+    err = capsys.readouterr().err
+    assert time.monotonic() - t0 < 5 and err.count('\n') == 1 and f'no Dask scheduler answers at {address}' in err

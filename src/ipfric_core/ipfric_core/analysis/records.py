@@ -14,9 +14,9 @@ at +/-pi (unwrapped) or is measured from hanging (pi at upright: mapped to uprig
 """
 from __future__ import annotations
 
+import codecs
 import csv
 import gzip
-import io
 from array import array
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -33,7 +33,10 @@ __all__ = ['Record', 'smallest_step', 'smooth_rate', 'angle_equation', 'upright_
 MIN_SAMPLES = 200
 MIN_PART_COUNTS = 100   # encoder counts an estimation or validation part must move at least
 MAX_ROWS = 2_000_000    # a longer CSV is refused (33 min at 1 kHz; identification would take hours)
-MAX_VOLTAGE = 1e3       # |u| beyond this is not a drive command [V]
+MAX_VOLTAGE = 100.0     # |u| beyond this is not a drive command [V] (lab drives give 5-48 V)
+MAX_CART_SPEED = 10.0   # a position step faster than this between two rows is a corrupt row [m/s]
+MIN_PERIOD_S = 1e-4     # shortest median sample period taken as seconds (10 kHz) [s]
+MAX_PERIOD_S = 0.1      # longest [s]
 OVERRUN_JUMP = 1.75     # a stamp step this many times the median period starts an overrun
 GAP_PERIODS = 20        # a stamp step this many median periods (and at least GAP_S) is a gap in the log
 GAP_S = 0.05            # [s]
@@ -278,18 +281,28 @@ def check_record(rec: Record, angle_zero: str = 'auto') -> Record:
         raise ConfigError(f'{rec.name}: time is not increasing at row {i + 2} '
                           f'(t = {rec.t[i]:g} then {rec.t[i + 1]:g} s)')
     period = float(np.median(d))
-    if not 1e-5 <= period <= 0.1:
-        raise ConfigError(f'{rec.name}: column t has a median sample period of {period:g}; expected seconds '
-                          f'between 1e-05 and 0.1 (is t in ms or ns?)')
+    if not MIN_PERIOD_S <= period <= MAX_PERIOD_S:
+        guess = ('minutes' if MIN_PERIOD_S <= 60 * period <= MAX_PERIOD_S else
+                 'ms' if MIN_PERIOD_S <= period / 1e3 <= MAX_PERIOD_S else
+                 'us or ns' if period > MAX_PERIOD_S else 'another unit')
+        raise ConfigError(f'{rec.name}: column t has a median sample period of {period:g}; allowed: seconds '
+                          f'between {MIN_PERIOD_S:g} and {MAX_PERIOD_S:g} (rigs sample at 10 Hz to 10 kHz); '
+                          f'is t in {guess}?')
     if np.ptp(rec.x) > 20.0:
         raise ConfigError(f'{rec.name}: column x spans {np.ptp(rec.x):g}; expected metres (a prismatic axis '
                           f'moves less than 20 m); is it in mm or counts?')
     if np.ptp(rec.x) == 0.0:
         raise ConfigError(f'{rec.name}: column x never changes; nothing moved')
+    speed = np.abs(np.diff(rec.x)) / d
+    if np.any(speed > MAX_CART_SPEED):
+        i = int(np.flatnonzero(speed > MAX_CART_SPEED)[0])
+        raise ConfigError(f'{rec.name}: column x jumps from {rec.x[i]:g} to {rec.x[i + 1]:g} m at row {i + 2} '
+                          f'(t = {rec.t[i + 1]:g} s), {speed[i]:.3g} m/s; allowed at most {MAX_CART_SPEED:g} m/s '
+                          f'between rows (a corrupt row, or x not in metres?); clean or cut the data')
     big = np.flatnonzero(np.abs(rec.u) > MAX_VOLTAGE)
     if len(big):
         raise ConfigError(f'{rec.name}: column voltage is {rec.u[big[0]]:g} at row {big[0] + 1}; allowed '
-                          f'|voltage| <= {MAX_VOLTAGE:g} (is it a drive command?)')
+                          f'|voltage| <= {MAX_VOLTAGE:g} V (a drive command; is it a corrupt row, or in mV?)')
     if not np.any(rec.u):
         raise ConfigError(f'{rec.name}: column voltage is 0 throughout; nothing drove the axis')
     notes = list(rec.notes)
@@ -364,16 +377,23 @@ def _text_lines(path: Path):
         raw: IO[bytes] = path.open('rb')
     except OSError as exc:
         raise ConfigError(f'{path}: cannot read ({exc.strerror})') from exc
-    data = gzip.GzipFile(fileobj=raw) if path.suffix.lower() == '.gz' else raw
-    stream = io.TextIOWrapper(data, encoding='utf-8-sig', errors='strict', newline='')
+    data: IO[bytes] | gzip.GzipFile = gzip.GzipFile(fileobj=raw) if path.suffix.lower() == '.gz' else raw
     try:
-        yield from enumerate(stream, 1)
-    except UnicodeDecodeError as exc:
-        raise ConfigError(f'{path}: not a text (UTF-8) CSV file: {exc.reason} near byte {exc.start}') from exc
+        for lineno, line in enumerate(data, 1):   # decoded line by line: an error names its line and column
+            if lineno == 1 and line.startswith(codecs.BOM_UTF8):
+                line = line[len(codecs.BOM_UTF8):]
+            try:
+                text = line.decode('utf-8')
+            except UnicodeDecodeError as exc:
+                raise ConfigError(f'{path}: line {lineno}, byte column {exc.start + 1}: byte '
+                                  f'{line[exc.start]:#04x} is not UTF-8 ({exc.reason}); not a text (UTF-8) CSV '
+                                  f'file: save it as UTF-8') from None
+            yield lineno, text
     except (OSError, EOFError) as exc:
         raise ConfigError(f'{path}: cannot read ({exc})') from exc
     finally:
-        stream.close()
+        data.close()
+        raw.close()
 
 
 def load_csv(path: str | Path, plant: PlantParams, columns: dict | None = None, angle_zero: str = 'auto',
@@ -417,6 +437,8 @@ def load_csv(path: str | Path, plant: PlantParams, columns: dict | None = None, 
                               f'({", ".join(header)})')
         for n, j in zip(names, where):
             try:
+                if '_' in fields[j]:   # float() reads 1_0.5 as 10.5
+                    raise ValueError
                 data[n].append(float(fields[j]))
             except ValueError:
                 raise ConfigError(f'{path}: row {lineno}, column {cols[n]!r}: {fields[j].strip()!r} is not a '
@@ -441,8 +463,13 @@ def load_bag(path: str | Path, plant: PlantParams | None = None, cart_alone: boo
     from .bagread import read_run
     run = read_run(path)
     if plant is None:
+        if run.truncated and not run.config:
+            raise ConfigError(f'{path}: the bag is truncated ({run.truncation_detail}): its scenario, stored at the '
+                              f'end of the file with the summary, is cut off, so the plant constants are missing; '
+                              f'give them with --plant')
         if not run.config or 'plant' not in run.config:
-            raise ConfigError(f'{path}: the bag stores no scenario; give the plant constants with --plant')
+            raise ConfigError(f'{path}: the bag stores no scenario (no plant section); give the plant constants '
+                              f'with --plant')
         plant = PlantParams.from_dict(run.config['plant'], 'bag scenario plant')
     k = np.searchsorted(run.t, run.command_t)
     ok = (k < len(run.t)) & (np.abs(run.t[np.minimum(k, len(run.t) - 1)] - run.command_t) < 1e-6)

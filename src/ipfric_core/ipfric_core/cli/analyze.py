@@ -11,7 +11,7 @@ from pathlib import Path
 from ..analysis.recorded_run import analyze_log, analyze_run, overlay_runs
 from ..analysis.records import ANGLE_ZEROS, is_log, parse_columns
 from ..physics.params import ConfigError
-from .output import print_json
+from .output import output_dir, print_json
 
 __all__ = ['NAME', 'HELP', 'add_arguments', 'main', 'print_run_analysis']
 
@@ -31,9 +31,10 @@ def add_arguments(a) -> None:
     a.add_argument('--angle-zero', choices=ANGLE_ZEROS, default='auto',
                    help='rig log: where its angle is zero (default %(default)s: hanging if mostly far from upright)')
     a.add_argument('--max-angle-deg', type=float, default=20.0,
-                   help='rig log: balanced while |theta| from upright is below this (default %(default)s deg)')
+                   help='rig log: balanced while |theta| from upright is below this (default %(default)s deg; '
+                   'allowed (0, 90])')
     a.add_argument('--min-balanced-s', type=float, default=2.0,
-                   help='rig log: shortest balanced stretch analysed (default %(default)s s)')
+                   help='rig log: shortest balanced stretch analysed (default %(default)s s; allowed (0, 1e6])')
 
 
 def print_run_analysis(r: dict) -> None:
@@ -90,7 +91,22 @@ def print_log_analysis(r: dict) -> None:
         print(f'  figure: {r["figure"]}')
 
 
+#: the allowed --max-angle-deg (deg from upright) and --min-balanced-s (s)
+MAX_ANGLE_DEG = (0.0, 90.0)
+MIN_BALANCED_S = (0.0, 1e6)
+
+
+def check_thresholds(max_angle_deg: float, min_balanced_s: float) -> None:
+    """The rig-log thresholds, checked: 0 < --max-angle-deg <= 90, 0 < --min-balanced-s <= 1e6."""
+    for option, v, (lo, hi), unit in (('--max-angle-deg', max_angle_deg, MAX_ANGLE_DEG, 'deg'),
+                                      ('--min-balanced-s', min_balanced_s, MIN_BALANCED_S, 's')):
+        if not (math.isfinite(v) and lo < v <= hi):
+            raise ConfigError(f'{option}: {v!r} is out of range; allowed ({lo:g}, {hi:g}] {unit}')
+
+
 def main(args) -> int:
+    check_thresholds(args.max_angle_deg, args.min_balanced_s)
+    output_dir(None if args.no_plots else args.plots, '--plots')
     plots = None if args.no_plots else args.plots
     logs = [p for p in args.runs if is_log(p)]
     if logs and len(logs) != len(args.runs):

@@ -7,7 +7,7 @@ import sys
 from ..run.demo import demo
 from ..run.scenario import DEFAULT_SCENARIO
 from .analyze import print_run_analysis
-from .output import print_json
+from .output import output_dir, print_json
 
 __all__ = ['NAME', 'HELP', 'add_arguments', 'main']
 
@@ -23,6 +23,7 @@ def add_arguments(m) -> None:
 
 
 def main(args) -> int:
+    output_dir(args.out)
     say = None if args.json else (lambda msg: print(f'[demo] {msg}', file=sys.stderr))
     res, summary = demo(args.config, args.out, args.duration, say)
     if summary is None:

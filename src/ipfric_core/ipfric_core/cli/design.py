@@ -12,7 +12,7 @@ from ..physics.params import ConfigError
 from ..run.scenario import DEFAULT_SCENARIO, load_scenario
 from ..study.check import MAX_DELAY, check_scenarios, friction_cases
 from ..study.check_page import write_check
-from .output import eig_text, paper_row, print_json, progress_lines
+from .output import eig_text, output_dir, paper_row, print_json, progress_lines
 
 __all__ = ['NAME', 'HELP', 'add_arguments', 'main']
 
@@ -45,6 +45,7 @@ def check(args) -> int:
     if args.from_ident and args.friction_change is not None:
         raise ConfigError('--friction-change with --from-ident: the identification\'s standard errors set the '
                           'friction cases; give one of them')
+    output_dir(args.out)
     try:
         base = load_scenario(config)
     except ConfigError as exc:

@@ -13,7 +13,7 @@ from ..ident.identify import SPLIT_RANGE, identify_record, identify_tables
 from ..ident.ladder_report import correlation_lines
 from ..ident.redesign import close_the_loop
 from ..run.scenario import DEFAULT_SCENARIO
-from .output import print_json
+from .output import output_dir, print_json
 
 __all__ = ['NAME', 'HELP', 'add_arguments', 'main']
 
@@ -136,6 +136,7 @@ def print_ladder(r: dict) -> None:
 
 
 def main(args) -> int:
+    output_dir(args.out)
     if args.loop:
         return loop(args)
     if args.data == 'paper':

@@ -8,9 +8,10 @@ from pathlib import Path
 from ..ident.uncertainty import report_draws
 from ..physics.params import ConfigError
 from ..run.scenario import DEFAULT_SCENARIO
-from ..study.montecarlo import DISTRIBUTIONS, montecarlo_study, spread_draws
+from ..study.executor import scheduler_address
+from ..study.montecarlo import DISTRIBUTIONS, check_duration, check_seed, montecarlo_study, spread_draws
 from ..study.variants import SENSORS, load_variant
-from .output import print_json, progress_counter
+from .output import output_dir, print_json, progress_counter
 
 __all__ = ['NAME', 'HELP', 'add_arguments', 'main']
 
@@ -24,7 +25,8 @@ def add_arguments(mc) -> None:
     mc.add_argument('--config', default=str(DEFAULT_SCENARIO),
                     help='scenario whose parameters are drawn (default %(default)s)')
     mc.add_argument('--runs', type=int, default=1000, help='number of runs (default %(default)s)')
-    mc.add_argument('--duration', type=float, default=20.0, help='simulated seconds per run (default %(default)s)')
+    mc.add_argument('--duration', type=float, default=20.0,
+                    help='simulated seconds per run (default %(default)s; at least 10 samples, at most 1e6 s)')
     mc.add_argument('--spread', metavar='NAME=S,...',
                     help='relative 1-sigma spreads of plant or friction coefficients, e.g. mu_s=0.3,mu_c=0.3,eps=0.3 '
                          '(30 %%); each value = nominal * (1 + S z), clipped to its range, mu_c <= mu_s')
@@ -34,7 +36,7 @@ def add_arguments(mc) -> None:
     mc.add_argument('--from-ident', metavar='DIR',
                     help='draw the fitted parameters of the final model of `./ipfric identify --out DIR` from '
                          'N(value, std^2), independently (the report has standard errors, no covariance)')
-    mc.add_argument('--seed', type=int, default=0, help='seed; run i draws with the seed (seed, i) '
+    mc.add_argument('--seed', type=int, default=0, help='seed, 0 .. 2**32-1; run i draws with the seed (seed, i) '
                     '(default %(default)s)')
     mc.add_argument('--sensors', choices=SENSORS, default='config',
                     help='the scenario\'s encoders, or exact states (default %(default)s)')
@@ -48,7 +50,12 @@ def main(args) -> int:
     if (args.spread is None) == (args.from_ident is None):
         raise ConfigError('give either --spread NAME=S,... (relative spreads) or --from-ident DIR (an '
                           'identification\'s parameter table)')
+    output_dir(args.out)
+    check_seed(args.seed)
+    if args.scheduler:
+        scheduler_address(args.scheduler)
     base = load_variant(args.config, args.sensors)
+    check_duration(args.duration, base)
     draw, drawn = (spread_draws(base, args.spread, args.seed, args.distribution) if args.spread is not None
                    else report_draws(args.from_ident, base, args.seed))
     title = f'{Path(args.config).stem}: {args.runs} runs of {args.duration:g} s, ' + (

@@ -8,7 +8,7 @@ import time
 from ..run.scenario import DEFAULT_SCENARIO
 from ..study.orbit_study import orbit_study
 from ..study.variants import load_variant
-from .output import print_json
+from .output import output_dir, print_json
 from .sweep import loop_variant_options
 
 __all__ = ['NAME', 'HELP', 'add_arguments', 'main']
@@ -25,18 +25,19 @@ def add_arguments(o) -> None:
     o.add_argument('--continue', dest='continue_', metavar='NAME=START:STOP[:POINTS]',
                    help='trace the branches of orbits over delay [s], gain or friction (multiples of the '
                    'scenario\'s gain, or of its mu_s, mu_c and eps) by continuation, first step 1/(POINTS-1) '
-                   'of the range (default 100), e.g. delay=0:0.14')
+                   'of the range (default 100, at most 2000), e.g. delay=0:0.14; delays in [0, 10] s, friction >= 0')
     o.add_argument('--delay', type=float, default=None,
-                   help='feedback delay [s] instead of the scenario\'s; it may fall between samples (the '
-                   '--simulate run takes it to whole samples)')
+                   help='feedback delay [s] instead of the scenario\'s, in [0, 10]; it may fall between samples '
+                   '(the --simulate run takes it to whole samples)')
     o.add_argument('--basin', metavar='LO,HI',
                    help='also find the edge of the upright\'s basin over the initial angle in [LO, HI] rad '
                    '(bisection: LO must settle, HI leave) and the unstable orbit the run at the edge lingers on; '
                    'with --continue its branch is traced too')
     o.add_argument('--duration', type=float, default=40.0,
-                   help='with --basin: longest run [s] (default %(default)s)')
+                   help='with --basin: longest run [s] (default %(default)s; at most 2e6 samples, 2000 s at 1 kHz)')
     o.add_argument('--simulate', type=float, default=120.0,
-                   help='also run the loop this many seconds and report its cycle beside the orbit (0 = no)')
+                   help='also run the loop this many seconds and report its cycle beside the orbit (0 = no; '
+                   'default %(default)s; at most 2e6 samples, 2000 s at 1 kHz)')
     o.add_argument('--scheduler', default=None, metavar='ADDRESS',
                    help='with --continue: compute the Jacobians\' columns on the Dask cluster whose scheduler '
                         'listens at ADDRESS (its workers run this project\'s environment); the same branches '
@@ -81,6 +82,7 @@ def print_continuation(c: dict) -> None:
 
 
 def main(args) -> int:
+    output_dir(args.out)
     base = load_variant(args.config, args.sensors, args.smoothing, args.cutoff_hz)
     t0 = time.perf_counter()
 

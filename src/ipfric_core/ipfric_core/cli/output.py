@@ -5,8 +5,26 @@ import json
 import sys
 import time
 from collections.abc import Callable
+from pathlib import Path
 
-__all__ = ['print_json', 'progress_counter', 'progress_lines', 'paper_row', 'eig_text']
+from ..physics.params import ConfigError
+
+__all__ = ['output_dir', 'print_json', 'progress_counter', 'progress_lines', 'paper_row', 'eig_text']
+
+
+def output_dir(path: str | Path | None, option: str = '--out') -> Path | None:
+    """``path`` of a command's output directory, checked before any work: a new or existing directory,
+    not an existing file (nor anything else that is not a directory). None stays None."""
+    if path is None:
+        return None
+    p = Path(path)
+    if p.exists() and not p.is_dir():
+        kind = 'a file' if p.is_file() else 'not a directory'
+        raise ConfigError(f'{option}: {str(path)} is {kind}; allowed: a directory (new or existing)')
+    for parent in p.parents:
+        if parent.exists() and not parent.is_dir():
+            raise ConfigError(f'{option}: {str(path)}: {parent} is a file; allowed: a directory (new or existing)')
+    return p
 
 
 def print_json(obj) -> None:

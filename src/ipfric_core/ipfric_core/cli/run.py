@@ -9,7 +9,7 @@ import sys
 
 from ..run.runner import Run
 from ..run.scenario import DEFAULT_SCENARIO, TIME_MODES
-from .output import print_json
+from .output import output_dir, print_json
 
 __all__ = ['NAME', 'HELP', 'add_arguments', 'main']
 
@@ -36,6 +36,7 @@ def add_arguments(r) -> None:
 
 
 def main(args) -> int:
+    output_dir(args.out)
     def to_interrupt(_signum, _frame):
         raise KeyboardInterrupt
     # explicit: a shell without job control starts background commands with SIGINT ignored

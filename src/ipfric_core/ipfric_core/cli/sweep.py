@@ -8,9 +8,10 @@ import sys
 
 from ..constants import REPO_ROOT
 from ..physics.params import ConfigError
+from ..study.executor import scheduler_address
 from ..study.sweep import figure_study, map_study, parse_range, resolution_report, threshold_report
 from ..study.variants import FIGURES, SCALED_SENSORS, SENSORS
-from .output import print_json, progress_counter
+from .output import output_dir, print_json, progress_counter
 
 __all__ = ['NAME', 'HELP', 'add_arguments', 'main', 'loop_variant_options']
 
@@ -28,7 +29,7 @@ def loop_variant_options(parser) -> None:
     parser.add_argument('--smoothing', choices=('none', 'tanh'), default=None,
                         help='override the friction smoothing')
     parser.add_argument('--cutoff-hz', type=float, default=None,
-                        help='override the controller\'s velocity filter corner [Hz] (0 = raw difference)')
+                        help='override the controller\'s velocity filter corner [Hz] (0 = raw difference; at most 1e4)')
 
 
 def add_arguments(w) -> None:
@@ -111,6 +112,9 @@ def figure(args, taus, progress) -> int:
 
 
 def main(args) -> int:
+    output_dir(args.out)
+    if args.scheduler:
+        scheduler_address(args.scheduler)
     if args.ros and args.scheduler:
         raise ConfigError('--ros with --scheduler: a ROS cell runs three node processes on this machine; '
                           'drop one of them')

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..physics.params import ConfigError, FrictionParams, PlantParams
+from ..physics.params import FRICTION_FIELDS, ConfigError, FrictionParams, PlantParams, check_number
 from ..run.scenario import Scenario
 from .model import FRICTION_FITTED, Model, declared
 
@@ -40,15 +40,46 @@ def load_report(path: str | Path) -> tuple[Model, dict[str, float], float]:
     if not isinstance(r, dict) or 'ladder' not in r or 'identified' not in r:
         raise ConfigError(f'--from-ident: {file} is not the result of a ladder identification (no ladder and '
                           f'identified sections; a force-input record such as EMPS has no rig to simulate)')
-    idf, last = r['identified'], r['ladder'][-1]
-    model = declared(PlantParams(**idf['plant']), FrictionParams(**idf['friction']), r['data']['pendulum'])
+    where = f'--from-ident: {file}'
+    try:
+        return _report_model(r, where)
+    except (KeyError, TypeError, IndexError, AttributeError) as exc:
+        raise ConfigError(f'{where}: malformed result: missing or invalid field {exc}; give the --out directory '
+                          f'of ./ipfric identify') from None
+
+
+def _report_model(r: dict, where: str) -> tuple[Model, dict[str, float], float]:
+    """:func:`load_report` of the parsed ``result.json`` ``r``, every field it uses checked."""
+    idf, ladder, data = r['identified'], r['ladder'], r.get('data')
+    if not isinstance(ladder, list) or not ladder:
+        raise ConfigError(f'{where}: the ladder is empty; allowed: the result of ./ipfric identify with its ladder')
+    for section in ('plant', 'friction'):
+        if not isinstance(idf, dict) or not isinstance(idf.get(section), dict):
+            raise ConfigError(f'{where}: identified.{section} is missing; allowed: a mapping of its parameters')
+    if not isinstance(data, dict):
+        raise ConfigError(f'{where}: the data section is missing (sample_period_s, pendulum)')
+    dt = data.get('sample_period_s')
+    if isinstance(dt, bool) or not isinstance(dt, (int, float)) or not (math.isfinite(dt) and 0 < dt <= 1.0):
+        raise ConfigError(f'{where}: data.sample_period_s {dt!r} is invalid; allowed (0, 1] s')
+    plant = PlantParams.from_dict(idf['plant'], f'{where}: identified.plant')
+    fr = idf['friction']
+    for k, v in fr.items():
+        if k in FRICTION_FIELDS and v is not None:
+            check_number(f'{where}: identified.friction.{k}', v, FRICTION_FIELDS[k])
+    last = ladder[-1]
+    model = declared(plant, FrictionParams(**fr), bool(data['pendulum']))
     for effect in last['effects']:
         model = model.with_effect(effect)
     model = model.with_free([p['name'] for p in last['params'] if p['fitted']])
+    for p in last['params']:
+        v, spec = p['value'], model.param(p['name'])
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not (math.isfinite(v) and spec.lo <= v <= spec.hi):
+            raise ConfigError(f'{where}: ladder parameter {p["name"]} = {v!r} is invalid; allowed '
+                              f'[{spec.lo:g}, {spec.hi:g}] {spec.unit}'.rstrip())
     model = model.with_values({p['name']: p['value'] for p in last['params']})
     std = {p['name']: float(p['std']) for p in last['params']
            if p['fitted'] and p['std'] is not None and math.isfinite(p['std']) and p['std'] > 0}
-    return model, std, float(r['data']['sample_period_s'])
+    return model, std, float(dt)
 
 
 def report_draw(model: Model, std: dict[str, float], dt: float, base: Scenario, seed: int,
@@ -96,8 +127,9 @@ def friction_cases(path: str | Path, base: Scenario) -> tuple[list[tuple[str, fl
 def report_draws(path: str | Path, base: Scenario, seed: int) -> tuple[Callable[[int], tuple[dict, Scenario]], dict]:
     """The Monte Carlo's draw of run i from an identification's parameter table (:func:`report_draw`),
     and what is drawn (for the summary)."""
-    if seed < 0:
-        raise ConfigError(f'--seed: {seed} must be >= 0 (run i draws with the seed (seed, i))')
+    if not 0 <= seed <= 2**32 - 1:
+        raise ConfigError(f'--seed: {seed} is out of range; allowed 0 .. {2**32 - 1} (run i draws with the seed '
+                          f'(seed, i))')
     model, std, dt = load_report(path)
     return (partial(report_draw, model, std, dt, base, seed),
             {'from_ident': str(path), 'std': std,

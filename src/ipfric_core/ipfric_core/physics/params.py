@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import re
+import stat
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -219,6 +220,8 @@ def load_yaml(path: str | Path) -> Any:
     """Parse a YAML file (UTF-8), turning every problem into ConfigError with the location."""
     path = Path(path)
     try:
+        if not stat.S_ISREG(path.stat().st_mode):
+            raise ConfigError(f'{path}: not a regular file (a FIFO, device or directory); allowed: a YAML file')
         raw = path.read_bytes()
     except OSError as exc:
         raise ConfigError(f'{path}: cannot read ({exc.strerror})') from exc

@@ -50,7 +50,7 @@ from .orbit import (
     shrunk,
 )
 
-__all__ = ['unstable_partners', 'trace', 'parse_continuation']
+__all__ = ['MAX_POINTS', 'unstable_partners', 'trace', 'parse_continuation']
 
 #: relative amplitude difference under which two orbits are the same
 SAME = 0.02
@@ -512,8 +512,13 @@ def trace(make_loop: Callable[[float], LoopNumbers], start: float, stop: float, 
     return tr.result
 
 
+#: the most points ``--continue`` may ask for (each point solves an orbit: 2000 take hours already)
+MAX_POINTS = 2000
+
+
 def parse_continuation(text: str) -> tuple[str, float, float, int]:
-    """``name=start:stop[:points]`` -> (name, start, stop, points); points default 100."""
+    """``name=start:stop[:points]`` -> (name, start, stop, points); points default 100, at most
+    :data:`MAX_POINTS`."""
     if '=' not in text:
         raise ValueError(f'--continue {text!r}: expected NAME=START:STOP[:POINTS], e.g. delay=0:0.14:100')
     name, spec = text.split('=', 1)
@@ -524,8 +529,10 @@ def parse_continuation(text: str) -> tuple[str, float, float, int]:
         count = int(parts[2]) if len(parts) == 3 else 100
         if count < 2 or (len(parts) == 3 and parts[2] != count):
             raise ValueError
-    except ValueError:
+    except (ValueError, OverflowError):
         raise ValueError(f'--continue {text!r}: expected START:STOP[:POINTS] (POINTS a whole number >= 2)') from None
+    if count > MAX_POINTS:
+        raise ValueError(f'--continue {text!r}: POINTS {count} is too many; allowed: 2 .. {MAX_POINTS}')
     if not all(math.isfinite(v) for v in parts[:2]) or parts[0] == parts[1]:
         raise ValueError(f'--continue {text!r}: START and STOP must be finite and different')
     return name.strip(), parts[0], parts[1], count

@@ -12,16 +12,41 @@ Importing this module loads nothing of Dask; only a scheduler address does.
 from __future__ import annotations
 
 import os
+import re
+import socket
 from concurrent.futures import Executor, ProcessPoolExecutor
 
-__all__ = ['SchedulerError', 'make_executor']
+from ..physics.params import ConfigError
+
+__all__ = ['SCHEDULER_SCHEMES', 'SchedulerError', 'scheduler_address', 'make_executor']
 
 #: seconds to wait for the scheduler before giving up
 CONNECT_TIMEOUT_S = 5.0
 
 
+#: the transports a scheduler address may name (no scheme: tcp)
+SCHEDULER_SCHEMES = ('tcp', 'tls')
+#: Dask's scheduler port when the address gives none
+DEFAULT_PORT = 8786
+_ADDRESS = re.compile(r'(?:(?P<scheme>[A-Za-z][A-Za-z0-9+.-]*)://)?'
+                      r'(?P<host>\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9](?:[A-Za-z0-9.-]*[A-Za-z0-9])?)'
+                      r'(?::(?P<port>[0-9]{1,5}))?/?')
+
+
 class SchedulerError(ConnectionError):
-    """The Dask scheduler of ``--scheduler`` cannot be reached (or the address is malformed)."""
+    """The Dask scheduler of ``--scheduler`` cannot be reached."""
+
+
+def scheduler_address(address: str) -> tuple[str, int]:
+    """(host, port) of ``--scheduler`` ADDRESS, ``[tcp://|tls://]HOST[:PORT]``, checked before any work."""
+    m = _ADDRESS.fullmatch(address.strip())
+    scheme = (m.group('scheme') or 'tcp').lower() if m else None
+    port = int(m.group('port') or DEFAULT_PORT) if m else 0
+    if m is None or scheme not in SCHEDULER_SCHEMES or not 1 <= port <= 65535:
+        raise ConfigError(f'--scheduler: {address!r} is not a scheduler address; allowed: '
+                          f'[{"|".join(s + "://" for s in SCHEDULER_SCHEMES)}]HOST[:PORT] with PORT 1..65535 '
+                          f'(default {DEFAULT_PORT}), e.g. tcp://10.0.0.5:8786')
+    return m.group('host').strip('[]'), port
 
 
 def make_executor(scheduler: str | None = None, workers: int | None = None,
@@ -35,6 +60,13 @@ def make_executor(scheduler: str | None = None, workers: int | None = None,
     """
     if scheduler is None:
         return ProcessPoolExecutor(max_workers=workers or os.cpu_count())
+    host, port = scheduler_address(scheduler)
+    try:   # a plain connection first: a Client that never connects takes 10 s more to close
+        socket.create_connection((host, port), timeout=timeout).close()
+    except OSError as exc:
+        raise SchedulerError(f'--scheduler {scheduler}: no Dask scheduler answers at {host}:{port} within '
+                             f'{timeout:g} s ({exc.strerror or type(exc).__name__}); start one with `dask scheduler` '
+                             f'and give its address, e.g. tcp://HOST:8786') from None
     from distributed import Client
     try:
         client = Client(scheduler, timeout=timeout, set_as_default=False)

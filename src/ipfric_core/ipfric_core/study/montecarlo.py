@@ -27,11 +27,12 @@ import numpy as np
 from ..analysis.oscillation import CLASSES
 from ..analysis.plots import CLASS_COLOURS, save_figure
 from ..physics.params import FRICTION_FIELDS, PLANT_FIELDS, ConfigError, Field
-from ..run.scenario import Scenario
-from .executor import make_executor
+from ..run.scenario import SIM_FIELDS, Scenario
+from .executor import make_executor, scheduler_address
 from .outcome import classify_run, true_p2p
 
-__all__ = ['DISTRIBUTIONS', 'parse_spread', 'spread_draw', 'run_chunk', 'run_montecarlo', 'spread_draws',
+__all__ = ['DISTRIBUTIONS', 'MAX_SEED', 'MIN_RUN_SAMPLES', 'check_seed', 'check_duration', 'parse_spread',
+           'spread_draw', 'run_chunk', 'run_montecarlo', 'spread_draws',
            'montecarlo_study']
 
 #: how a relative spread s turns into a factor on the nominal value
@@ -162,14 +163,37 @@ def write_results(rows: list[dict], info: dict, out: str | Path, title: str) -> 
     return summary
 
 
+#: the largest seed (run i draws with the seed (seed, i)); seeds are 0 .. MAX_SEED
+MAX_SEED = 2**32 - 1
+#: the fewest samples a run may take (--duration at least this many sample periods)
+MIN_RUN_SAMPLES = 10
+
+
+def check_seed(seed: int) -> int:
+    """``--seed`` checked: a whole number in 0 .. :data:`MAX_SEED`."""
+    if not 0 <= seed <= MAX_SEED:
+        raise ConfigError(f'--seed: {seed} is out of range; allowed 0 .. {MAX_SEED} (run i draws with the '
+                          f'seed (seed, i))')
+    return seed
+
+
+def check_duration(duration: float, base: Scenario) -> float:
+    """``--duration`` [s] checked: finite, at least :data:`MIN_RUN_SAMPLES` samples of ``base``'s loop and
+    at most the scenario schema's 1e6 s."""
+    lo, hi = MIN_RUN_SAMPLES * base.sample_period, SIM_FIELDS['duration'].hi
+    if not (math.isfinite(duration) and lo <= duration <= hi):
+        raise ConfigError(f'--duration: {duration!r} s is out of range; allowed {lo:g} .. {hi:g} s (at least '
+                          f'{MIN_RUN_SAMPLES} samples of {base.sample_period:g} s)')
+    return duration
+
+
 def spread_draws(base: Scenario, text: str, seed: int, distribution: str = 'normal'
                  ) -> tuple[Callable[[int], tuple[dict, Scenario]], dict]:
     """The draw of run i from relative spreads ``text`` ('mu_s=0.3,mu_c=0.3'), and what is drawn (for the
     summary)."""
     if distribution not in DISTRIBUTIONS:
         raise ConfigError(f'--distribution: {distribution!r} is not one of {", ".join(DISTRIBUTIONS)}')
-    if seed < 0:
-        raise ConfigError(f'--seed: {seed} must be >= 0 (run i draws with the seed (seed, i))')
+    check_seed(seed)
     spread = parse_spread(text)
     meaning = ('value = nominal * (1 + s z), z ~ N(0, 1)' if distribution == 'normal' else
                'value = nominal * (1 + s u), u ~ U(-1, 1)')
@@ -188,6 +212,8 @@ def montecarlo_study(draw: Callable[[int], tuple[dict, Scenario]], info: dict, r
         raise ConfigError(f'--duration: {duration!r} must be > 0 s')
     if workers is not None and workers < 1:
         raise ConfigError(f'--workers: {workers} must be >= 1')
+    if scheduler:
+        scheduler_address(scheduler)
     rows = run_montecarlo(draw, runs, duration, workers, scheduler, progress)
     return write_results(rows, {**info, 'runs': runs, 'duration_s': duration}, out, title)
 

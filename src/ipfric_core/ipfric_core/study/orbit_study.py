@@ -17,20 +17,33 @@ from contextlib import nullcontext
 from pathlib import Path
 
 from ..design.describing import hunting_over_delays, hunting_over_gain_scales
-from ..physics.params import ConfigError
-from ..run.scenario import Scenario
+from ..physics.params import ConfigError, check_number
+from ..run.scenario import CONTROLLER_FIELDS, Scenario
 from .basin import Edge, basin_edge, shape_threshold
 from .bifurcation import diagram
 from .continuation import parse_continuation, trace, unstable_partners
-from .executor import make_executor
+from .executor import make_executor, scheduler_address
 from .orbit import OrbitError, find_orbit, simulated_cycle
 from .variants import PARAMETERS, loop_of, scenario_at
 
-__all__ = ['DIAGRAM_SIMULATIONS', 'orbit_delay', 'continuation_of', 'basin_bracket', 'orbits_at', 'basin_of',
-           'continuation_study', 'orbit_study']
+__all__ = ['DIAGRAM_SIMULATIONS', 'MAX_RUN_SAMPLES', 'check_run_length', 'orbit_delay', 'continuation_of',
+           'basin_bracket', 'orbits_at', 'basin_of', 'continuation_study', 'orbit_study']
 
 #: simulations from the start drawn beside the branches of a diagram, evenly over its range
 DIAGRAM_SIMULATIONS = 29
+#: the most samples one simulated run (``--simulate``, a ``--basin`` run) may take: 2e6 (2000 s at 1 kHz)
+MAX_RUN_SAMPLES = 2_000_000
+
+
+def check_run_length(option: str, seconds: float, base: Scenario, zero: bool = False) -> float:
+    """``seconds`` of a simulated run, checked: finite, > 0 (or 0 with ``zero``), at most
+    :data:`MAX_RUN_SAMPLES` samples of ``base``'s loop."""
+    longest = MAX_RUN_SAMPLES * base.sample_period
+    low = '0' if zero else '0 (exclusive)'
+    if not (math.isfinite(seconds) and (seconds >= 0 if zero else seconds > 0) and seconds <= longest):
+        raise ConfigError(f'{option}: {seconds!r} s is out of range; allowed {low} .. {longest:g} s '
+                          f'({MAX_RUN_SAMPLES} samples at {1 / base.sample_period:g} Hz)')
+    return seconds
 
 
 def orbit_delay(base: Scenario, delay: float | None) -> tuple[float, Scenario]:
@@ -38,8 +51,7 @@ def orbit_delay(base: Scenario, delay: float | None) -> tuple[float, Scenario]:
     samples), and the scenario runs are made with (the delay rounded to whole samples)."""
     if delay is None:
         return base.controller.delay, base
-    if not (math.isfinite(delay) and delay >= 0):
-        raise ConfigError(f'--delay: {delay!r} must be finite and >= 0 s')
+    check_number('--delay', delay, CONTROLLER_FIELDS['delay'])
     return delay, scenario_at(base, 'delay', delay)
 
 
@@ -52,8 +64,13 @@ def continuation_of(text: str) -> tuple[str, float, float, int]:
     if cont[0] not in PARAMETERS:
         raise ConfigError(f'--continue {cont[0]!r}: unknown parameter; allowed: {", ".join(PARAMETERS)} '
                           '(delay [s]; gain and friction as multiples of the scenario\'s)')
-    if cont[0] == 'delay' and min(cont[1:3]) < 0:
-        raise ConfigError('--continue delay: delays must be >= 0 s')
+    if cont[0] == 'delay':
+        spec = CONTROLLER_FIELDS['delay']
+        if min(cont[1:3]) < spec.lo or max(cont[1:3]) > spec.hi:
+            raise ConfigError(f'--continue {text!r}: delays out of range; allowed {spec.describe()}')
+    if cont[0] == 'friction' and min(cont[1:3]) < 0:
+        raise ConfigError(f'--continue {text!r}: a negative friction scale; allowed >= 0 (multiples of the '
+                          'scenario\'s mu_s, mu_c, eps)')
     return cont
 
 
@@ -141,9 +158,12 @@ def orbit_study(base: Scenario, out: str | Path, delay: float | None = None, bas
     """Everything ``./ipfric orbit`` reports on ``base`` (see the module docstring), written to
     ``out/orbit.json`` after ``info``; ``basin``: 'LO,HI' [rad], ``cont``: 'NAME=START:STOP[:POINTS]'."""
     continuation = continuation_of(cont) if cont else None
+    if scheduler:
+        scheduler_address(scheduler)
     bracket = basin_bracket(basin, duration) if basin else None
-    if not (math.isfinite(simulate) and simulate >= 0):
-        raise ConfigError(f'--simulate: {simulate!r} must be >= 0 s (0 = no run beside the orbits)')
+    if bracket:
+        check_run_length('--duration', duration, base)
+    check_run_length('--simulate', simulate, base, zero=True)
     delay, base = orbit_delay(base, delay)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

@@ -13,8 +13,8 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..constants import REPO_ROOT
-from ..physics.params import ConfigError
-from ..run.scenario import Scenario, load_scenario
+from ..physics.params import ConfigError, check_number
+from ..run.scenario import CONTROLLER_FIELDS, Scenario, load_scenario
 from .orbit import LoopNumbers, loop_numbers
 
 __all__ = ['PARAMETERS', 'SENSORS', 'SCALED_SENSORS', 'FIGURES', 'FIGURE_GRIDS', 'exact_sensors', 'scenario_at',
@@ -84,8 +84,7 @@ def variant(base: Scenario, sensors: str = 'config', smoothing: str | None = Non
     if sensors not in SENSORS:
         raise ConfigError(f'--sensors: {sensors!r} is not one of {", ".join(SENSORS)}')
     if cutoff_hz is not None:
-        if not (math.isfinite(cutoff_hz) and cutoff_hz >= 0):
-            raise ConfigError(f'--cutoff-hz: {cutoff_hz!r} must be >= 0 Hz (0 = raw difference)')
+        check_number('--cutoff-hz', cutoff_hz, CONTROLLER_FIELDS['cutoff_hz'])
         base = replace(base, controller=replace(base.controller, cutoff_hz=cutoff_hz))
     if sensors == 'exact':
         base = exact_sensors(base)
