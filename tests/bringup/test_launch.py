@@ -169,6 +169,7 @@ def test_a_refused_launch_writes_nothing(ros2_env, tmp_path):
 
 
 @pytest.mark.slow
+@pytest.mark.long
 def test_ctrl_c_of_a_launch_records_abort_before_the_bag_closes(ros2_env, tmp_path):
     """Ctrl-C in the terminal of `ros2 launch` (SIGINT to the whole process group, every node at
     once), 10 times: each bag ends with ABORT and is whole."""

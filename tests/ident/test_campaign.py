@@ -5,9 +5,9 @@ Fast: the generator is reproducible (the same (seed, index) gives the same bytes
 case is physically sane; the scorer's rules on hand-made answers.
 
 Slow: ten fixed cases of seed 2026 identified by ``ipfric identify`` as the campaign runs it,
-each with the answer it should give. Each takes one to two minutes on two cores, so the suite runs
-the cases :data:`IN_SUITE` (a clean record, an offset, a delay); ``IPFRIC_CAMPAIGN=all`` runs the
-other seven too, which the identification does not answer right yet (marked xfail, strict: one
+each with the answer it should give. Each takes one to two minutes on two cores (marked long: not
+in the default run; ``./ipfric test -m long``): the cases :data:`IN_SUITE` (a clean record, an
+offset, a delay); ``IPFRIC_CAMPAIGN=all`` runs the other seven too, which the identification does not answer right yet (marked xfail, strict: one
 that starts passing fails the run until it joins the suite).
 """
 import json
@@ -37,16 +37,16 @@ FIXED = {
 }
 
 
-#: the fixed cases the suite runs; the others only with IPFRIC_CAMPAIGN=all
+#: the fixed cases `-m long` runs; the others only with IPFRIC_CAMPAIGN=all too
 IN_SUITE = (2, 66, 131)
 ALL = os.environ.get('IPFRIC_CAMPAIGN') == 'all'
 
 
 def fixed_params():
     for i, (what, right) in FIXED.items():
-        marks = [] if i in IN_SUITE else [
+        marks = [pytest.mark.long] + ([] if i in IN_SUITE else [
             pytest.mark.skipif(not ALL, reason='one of the seven slow cases: IPFRIC_CAMPAIGN=all'),
-            pytest.mark.xfail(strict=True, reason=f'{what}: not yet identified as {right}')]
+            pytest.mark.xfail(strict=True, reason=f'{what}: not yet identified as {right}')])
         yield pytest.param(i, id=f'{i}-{right}', marks=marks)
 
 

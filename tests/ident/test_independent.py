@@ -65,8 +65,13 @@ def data(tmp_path_factory):
     return paths
 
 
+#: the cases of the default run (one clean and one effect for each experiment); the others are marked long
+IN_SUITE = ('cart_none', 'cart_deadzone', 'loop_none', 'loop_delay', 'loop_bias')
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize('case, kept, expect', CASES, ids=[c[0] for c in CASES])
+@pytest.mark.parametrize('case, kept, expect', [
+    pytest.param(*c, id=c[0], marks=[] if c[0] in IN_SUITE else [pytest.mark.long]) for c in CASES])
 def test_undeclared_effect_in_independent_data(data, case, kept, expect):
     rec = load(data[case], None)
     est, val = rec.split(0.6)

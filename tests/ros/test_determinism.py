@@ -19,7 +19,7 @@ from ipfric_core.physics.closedloop import run_closed_loop
 from ipfric_core.run.runner import run
 from ipfric_core.run.scenario import load_scenario
 
-pytestmark = [pytest.mark.ros, pytest.mark.slow]
+pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.long]
 RUNS = int(os.environ.get('IPFRIC_DETERMINISM_RUNS', '3'))
 DURATION = float(os.environ.get('IPFRIC_DETERMINISM_DURATION', '10'))
 BUSY = 5          # busy processes beside the run: a load of about 5-7 on 2 cores
