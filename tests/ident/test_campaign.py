@@ -7,8 +7,9 @@ case is physically sane; the scorer's rules on hand-made answers.
 Slow: ten fixed cases of seed 2026 identified by ``ipfric identify`` as the campaign runs it,
 each with the answer it should give. Each takes one to two minutes on two cores (marked long: not
 in the default run; ``./ipfric test -m long``): the cases :data:`IN_SUITE` (a clean record, an
-offset, a delay); ``IPFRIC_CAMPAIGN=all`` runs the other seven too, which the identification does not answer right yet (marked xfail, strict: one
-that starts passing fails the run until it joins the suite).
+offset, a delay); ``IPFRIC_CAMPAIGN=all`` runs the other seven too, which the identification
+does not answer right yet (marked xfail, strict: one that starts passing fails the run until it
+joins the others).
 """
 import json
 import math
