@@ -55,7 +55,7 @@ CASES = [
     ('domain 999', {'s.yaml': CFG}, RUN + ['--domain', '999'], 2, '--domain: 999 is out of range; allowed 0..232'),
     ('timeout -5', {'s.yaml': CFG}, RUN + ['--timeout', '-5'], 2, '--timeout: -5.0 must be > 0 wall seconds'),
     ('duration nan', {'s.yaml': CFG}, RUN + ['--duration', 'nan'], 2, '--duration: nan must be >= 0 s'),
-    ('out is a file', {'s.yaml': CFG, 'out': b'my notes\n'}, RUN, 2, 'is a file; give a directory'),
+    ('out is a file', {'s.yaml': CFG, 'out': b'my notes\n'}, RUN, 2, 'is a file; allowed: a directory'),
     ('out holds a bag', {'s.yaml': CFG, 'out/bag/metadata.yaml': b'x: 1\n'}, RUN, 2,
      'bag exists already; choose another --out'),
     ('bag is random bytes', {'b.mcap': bytes(range(256)) * 8}, ['analyze', '--no-plots', '{dir}/b.mcap'], 2,

@@ -91,7 +91,8 @@ def test_recorded_counts_equal_published_counts(runs):
                              '/diagnostics': diagnostics}
     assert res.counts_match
     assert bag.counts == {'/clock': n, '/joint_states': n, '/plant_state': n, '/voltage_command': n,
-                          '/safety_event': 2, '/controller_gain': 1, '/diagnostics': diagnostics}
+                          '/safety_event': 2, '/controller_gain': 1, '/diagnostics': diagnostics,
+                          '/parameter_events': 0}     # the rig's parameter changes: none in this run
     # the controller's own count (logged at its shutdown) equals the recorded commands
     log = (res.out and open(f'{res.out}/logs/controller_node.log').read())
     assert f'published {n} commands' in log

@@ -8,7 +8,7 @@ from pathlib import Path
 
 from ..analysis.records import parse_columns
 from ..design.paperconfig import DEFAULT_DATA
-from ..ident.free_run import INIT_SAMPLES
+from ..ident.held_out import INIT_SAMPLES
 from ..ident.identify import SPLIT_RANGE, identify_record, identify_tables
 from ..ident.ladder_report import correlation_lines
 from ..ident.redesign import close_the_loop

@@ -10,7 +10,7 @@ from ..lazy import lazy_package
 __all__, __getattr__ = lazy_package(__name__, __path__, {
     'identify': ('identify_record',),
     'ladder': ('run_ladder',),
-    'free_run': ('free_run',),
+    'held_out': ('free_run',),
     'model': ('Model', 'declared', 'load_declared'),
     'effects': ('EFFECTS',),
     'redesign': ('export_scenario', 'close_the_loop'),

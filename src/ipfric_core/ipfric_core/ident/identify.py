@@ -7,7 +7,7 @@ a second file for validation), and runs the ladder (:mod:`ipfric_core.ident.ladd
 force-input record that declares no plant (EMPS: the force is gain * u) starts the ladder from
 its force balance (:func:`force_input_model`), and its report adds the relative force error of
 each step (the EMPS benchmark's metric). With a test record, the final model is also run free
-over it (:mod:`ipfric_core.ident.free_run`). The report is written into the output directory,
+over it (:mod:`ipfric_core.ident.held_out`). The report is written into the output directory,
 and the identified rig exported as a scenario when asked.
 """
 from __future__ import annotations
@@ -21,7 +21,7 @@ from ..physics.params import ConfigError, FrictionParams, PlantParams
 from ..run.scenario import DEFAULT_SCENARIO, load_scenario
 from .effects import EFFECTS, PARAMS
 from .equation_error import base_fit, force_error, identify_steady, structure_fit
-from .free_run import INIT_SAMPLES, free_run
+from .held_out import INIT_SAMPLES, free_run
 from .ladder import Problem, Step, run_ladder, verdict
 from .ladder_report import write_ladder_report
 from .model import LAW_PARAMS, Model, declared, read_declared

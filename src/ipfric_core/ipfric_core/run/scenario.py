@@ -67,7 +67,8 @@ from ..physics.params import (
 from ..physics.plant import CartPendulum
 from ..physics.rig import PLANT_TRUTH_FIELDS, PlantTruth, Rig
 
-__all__ = ['DEFAULT_SCENARIO', 'TIME_MODES', 'NODE_NAMES', 'SECTION_KEYS', 'Scenario', 'check_namespace', 'key_matches',
+__all__ = ['DEFAULT_SCENARIO', 'TIME_MODES', 'NODE_NAMES', 'SECTION_KEYS', 'SIM_FIELDS', 'CONTROLLER_FIELDS',
+           'Scenario', 'check_namespace', 'key_matches',
            'nest', 'node_sections', 'scenario_from_ros_params', 'scenario_from_sections', 'load_scenario',
            'scenario_path']
 
