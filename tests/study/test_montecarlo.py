@@ -29,6 +29,8 @@ def test_draws_depend_on_seed_and_run_only(fig7):
     assert scn.controller == fig7.controller and scn.sim == fig7.sim
     draws = [spread_draw(fig7, {'mu_s': 1.0, 'mu_c': 1.0}, 0, i)[1].friction for i in range(200)]
     assert all(0.0 <= f.mu_c <= f.mu_s for f in draws)                  # clipped to the range, mu_c <= mu_s
+    keys = {tuple(spread_draw(fig7, {'mu_s': 1.0}, 0, i)[0]) for i in range(200)}
+    assert keys == {('mu_s', 'mu_c')}            # a spread of mu_s alone: every run's row holds the mu_c it ran
     uniform = [spread_draw(fig7, {'eps': 0.3}, 0, i, 'uniform')[0]['eps'] for i in range(200)]
     assert 0.7 * fig7.friction.eps <= min(uniform) and max(uniform) <= 1.3 * fig7.friction.eps
     with pytest.raises(ConfigError, match='--spread: .mu_k. is not a coefficient'):

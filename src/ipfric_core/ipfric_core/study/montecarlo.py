@@ -95,7 +95,8 @@ def spread_draw(base: Scenario, spread: dict[str, float], seed: int, index: int,
     plant, friction = replace(base.plant, **drawn['plant']), replace(base.friction, **drawn['friction'])
     if friction.mu_c > friction.mu_s:
         friction = replace(friction, mu_c=friction.mu_s)
-        values['mu_c'] = friction.mu_s
+    if 'mu_s' in spread or 'mu_c' in spread:      # the mu_c run (clipped or not): every row has the same keys
+        values['mu_c'] = friction.mu_c
     return values, replace(base, plant=plant, friction=friction)
 
 
