@@ -171,3 +171,25 @@ def test_constant_angle_column_is_a_removed_pendulum(tmp_path):
     assert load(tmp_path / 'swing.csv', None).theta is not None
     rec = load(tmp_path / 'swing.csv', None, cart_alone=True)
     assert rec.theta is None and any('--cart-alone' in n for n in rec.notes)
+
+
+@pytest.mark.parametrize('mangle, words', [
+    (lambda d: (d['x'], d['theta']), None),
+    (lambda d: (d['theta'], d['x']), 'x and theta look swapped'),
+    (lambda d: (d['x'], np.rad2deg(d['theta'])), 'theta looks like degrees'),
+])
+def test_columns_that_parse_but_cannot_be_right_are_refused(tmp_path, capsys, mangle, words):
+    """A closed-loop log of the independent simulator (30 s, the paper's pendulum) read as written, with x
+    and theta swapped, and with theta in degrees: the pendulum's own equation tells them apart."""
+    from independent import rigsim
+    d = rigsim.generate('loop_none')
+    x, th = mangle(d)
+    path = tmp_path / 'log.csv'
+    np.savetxt(path, np.column_stack([d['t'], x, d['voltage'], th]), delimiter=',', header='t,x,voltage,theta',
+               comments='', fmt='%.10g')
+    code = main(['analyze', str(path), '--no-plots'])
+    err = capsys.readouterr().err
+    if words is None:
+        assert code == 0, err
+    else:
+        assert code == 2 and words in err and 'allowed' in err, err

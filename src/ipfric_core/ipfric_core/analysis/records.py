@@ -17,6 +17,7 @@ from __future__ import annotations
 import codecs
 import csv
 import gzip
+import math
 from array import array
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -203,6 +204,26 @@ def angle_equation(t, x, theta) -> tuple[np.ndarray, np.ndarray]:
     return coef, coef / np.sqrt(np.maximum(np.diag(cov), 1e-300))
 
 
+def misread(t, x, theta, l: float, g: float) -> None:
+    """Refuse a record whose columns parse but cannot be right, by the pendulum's own equation
+    (:func:`angle_equation`, its terms of the declared pendulum's size): theta in degrees (the gravity
+    term does not change with the angle's unit, the coupling to the cart grows 57.3 times), or x and
+    theta swapped (the gravity term shows only when they are read the other way round)."""
+    (grav, coupling), (t_grav, t_coupling) = angle_equation(t, x, theta)
+    if abs(t_coupling) >= CONVENTION_T and 0.6 < abs(coupling) / (0.75 / l) / math.degrees(1.0) < 1.6:
+        raise ConfigError(f'columns: theta looks like degrees, not radians: the pendulum\'s coupling to the '
+                          f'cart is {abs(coupling):.3g} per unit (t = {abs(t_coupling):.3g}) where the declared '
+                          f'pendulum gives {0.75 / l:.3g} per rad; allowed: theta in rad')
+    if abs(t_grav) >= CONVENTION_T and 0.6 < abs(grav) / (0.75 * g / l) < 1.6:
+        return
+    (grav, _), (t_grav, _) = angle_equation(t, theta, x)
+    if abs(t_grav) >= CONVENTION_T and 0.6 < abs(grav) / (0.75 * g / l) < 1.6:
+        raise ConfigError(f'columns: x and theta look swapped: the pendulum\'s equation shows its gravity term '
+                          f'(t = {abs(t_grav):.3g}, {abs(grav):.3g} 1/s^2 where the declared pendulum gives '
+                          f'{0.75 * g / l:.3g}) only when they are read the other way round; allowed: x in m, '
+                          f'theta in rad (--columns maps them)')
+
+
 def upright_angle(t, x, theta, l: float, g: float, zero: str = 'auto') -> tuple[np.ndarray, list[str]]:
     """The angle column as the model takes it: radians from upright, the paper's sign, unwrapped
     (a hanging pendulum about pi). ``zero`` says where the column is zero: 'upright', 'hanging' (then
@@ -222,6 +243,8 @@ def upright_angle(t, x, theta, l: float, g: float, zero: str = 'auto') -> tuple[
     # a term decides when it is significant and of the size the declared pendulum gives it (0.6-1.6x)
     shows_gravity = abs(t_grav) >= CONVENTION_T and 0.6 < abs(grav) / (0.75 * g / l) < 1.6
     shows_coupling = abs(t_coupling) >= CONVENTION_T and 0.6 < abs(coupling) / (0.75 / l) < 1.6
+    if zero == 'auto':
+        misread(t, x, th, l, g)
     turns = np.round(np.median(th) / (2 * np.pi))
     far = np.median(np.abs(th - 2 * np.pi * turns)) > np.pi / 2
     if zero == 'auto' and shows_gravity:
