@@ -53,7 +53,8 @@ __all__ = ['held', 'advance', 'advance_drive', 'friction_now', 'Simulator']
 MAX_EVENTS = 64  # per substep; a guard, never reached in normal motion
 XTOL = 1e-13     # event time tolerance [s]
 CONTACT_STEPS = 40       # steps per period of the drive's contact oscillation (and of the bristles')
-MAX_BRISTLE_STEPS = 1000  # steps of the dynamic law within one substep at most
+MAX_BRISTLE_STEPS = 100   # steps of the dynamic law within one substep at most (stiffer bristles than a
+#                           record's substep can carry diverge, and their fit fails on its own)
 NO_DRIVE = (0.0, 0.0, 0.0, 0.0)   # (play [m], motor-side mass [kg], stiffness [N/m], damping [N s/m]): rigid
 
 
