@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from ipfric_core.analysis.oscillation import classify, crossing_period
+from ipfric_core.cli.output import print_json
 from ipfric_core.constants import REPO_ROOT
 from ipfric_core.physics.closedloop import run_closed_loop
 from ipfric_core.run.scenario import load_scenario
@@ -410,3 +411,26 @@ def run_all(quick: bool = False, realtime_s: float = 600.0, results: Path | None
             f'goes: docs/performance.md.\n\n{text}\n')
     return {'quick': quick, 'machine': info, 'rows': rows, 'table': text,
             'results': str(results) if results else None}
+
+
+def main(argv=None) -> int:
+    """``python -m bench.run [--quick] [--realtime-duration S] [--results FILE] [--json]`` (what
+    ``./ipfric bench`` runs): the table on stdout, or the whole result as JSON."""
+    import argparse
+    p = argparse.ArgumentParser(prog='python -m bench.run', description=main.__doc__)
+    p.add_argument('--quick', action='store_true')
+    p.add_argument('--realtime-duration', type=float, default=600.0)
+    p.add_argument('--results', type=Path, required=True)
+    p.add_argument('--json', action='store_true')
+    a = p.parse_args(argv)
+    out = run_all(a.quick, a.realtime_duration, a.results, progress=lambda msg: print(msg, file=sys.stderr))
+    if a.json:
+        print_json(out)
+    else:
+        print(out['table'])
+        print(f'written: {out["results"]}')
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

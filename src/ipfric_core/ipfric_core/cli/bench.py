@@ -2,11 +2,12 @@
 ``bench/RESULTS.md``."""
 from __future__ import annotations
 
+import subprocess
 import sys
 from pathlib import Path
 
 from ..constants import REPO_ROOT
-from .output import print_json
+from ..physics.params import ConfigError
 
 __all__ = ['NAME', 'HELP', 'add_arguments', 'main']
 
@@ -26,13 +27,12 @@ def add_arguments(b) -> None:
 
 
 def main(args) -> int:
-    sys.path.insert(0, str(REPO_ROOT))      # bench/ is part of the checkout, not of the package
-    from bench.run import run_all
+    """The benchmarks of the checkout's ``bench/`` in a process of their own (``python -m bench.run``:
+    the package does not import the checkout)."""
+    if not (REPO_ROOT / 'bench' / 'run.py').is_file():
+        raise ConfigError(f'bench: {REPO_ROOT / "bench"} is not there; the benchmarks run from a checkout')
     results = Path(args.results) if args.results else (QUICK_RESULTS if args.quick else RESULTS)
-    out = run_all(args.quick, args.realtime_duration, results, progress=(lambda msg: print(msg, file=sys.stderr)))
-    if args.json:
-        print_json(out)
-        return 0
-    print(out['table'])
-    print(f'written: {out["results"]}')
-    return 0
+    cmd = [sys.executable, '-m', 'bench.run', '--realtime-duration', str(args.realtime_duration),
+           '--results', str(results.resolve())]
+    cmd += (['--quick'] if args.quick else []) + (['--json'] if args.json else [])
+    return subprocess.run(cmd, cwd=REPO_ROOT).returncode
