@@ -3,7 +3,11 @@
 The record is cut into windows. Each window starts from the measured state: encoder
 positions, at rest and held by static friction where the encoder stood still around the
 start (windows start there whenever they can: that state is known exactly), else with
-velocities from a local fit. The cart is judged on windows of ``CART_WINDOW_S``; with a
+velocities from a local fit, and the cart's rate then refined by the model itself to the one
+(or the rest) that best replays the window's first ``START_FIT_S`` of readings: a cart that
+stops and starts within the local fit's span (a balancing loop chattering at its sample rate)
+gets the mean rate of that span from the fit, and the model would carry its error through the
+window. The cart is judged on windows of ``CART_WINDOW_S``; with a
 pendulum attached its angle is taken from the measurement there (the upright pendulum is
 unstable: a small error in its initial rate would grow into the cart's motion), and the
 angle itself is judged on short windows of ``PENDULUM_WINDOW_S`` of the free coupled motion. The model (the
@@ -39,6 +43,13 @@ PENDULUM_WINDOW_S = 0.25
 STILL_S = 0.02       # an encoder standing still this long before and after a sample: at rest [s]
 FILTER_HZ = 25.0     # corner of the velocity estimate at window starts [Hz]
 REST_SPAN = 3.0      # a window reaches this many times its length to end at a rest
+#: a window that starts in motion starts at the cart rate that best replays its readings over this long
+#: (the local fit's rate smooths a cart that stops and starts within its span) [s]
+START_FIT_S = 0.02
+#: the start rates tried: the local fit's plus these multiples of the larger of its size and START_COUNTS
+#: counts over START_FIT_S (and the vertex of the parabola through the best)
+START_RATES = np.array([-1.5, -1.0, -0.6, -0.3, -0.1, 0.0, 0.1, 0.3, 0.6, 1.0, 1.5])
+START_COUNTS = 10.0
 LEAD_S = 0.1         # no window starts earlier: a delayed command there would come from before the record [s]
 
 
@@ -193,40 +204,107 @@ def drive_states(pp, gap, mass, t, u, motion):
     return out
 
 
+@compiled
+def _sample(pp, fp, ef, deadzone, saturation, drive, first, durations, commands, k, s, mode, dr, substep, forced,
+            theta_bias, pendulum):
+    """The state after sample interval k, integrated over its pieces of constant applied command (the
+    angle set to the measured one where ``forced`` has rows, held at 0 without a pendulum)."""
+    for j in range(first[k], first[k + 1]):
+        v = input_effects(commands[j], deadzone, saturation)
+        if drive[0] > 0.0:
+            s, mode, dr = advance_drive(pp, fp, ef, s, mode, dr, v, durations[j], substep, drive)
+        else:
+            s, mode = advance(pp, fp, ef, s, mode, v, durations[j], substep)
+    if len(forced) > 0:
+        s = (s[0], forced[k + 1, 0] - theta_bias, s[2], forced[k + 1, 1], s[4])
+    elif not pendulum:
+        s = (s[0], 0.0, s[2], 0.0, s[4])
+    return s, mode, dr
+
+
+@compiled
+def _start_cost(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, first, durations, commands, k0, k1,
+                s, mode, dr, substep, forced, pendulum, xm):
+    """Squared error [m^2] of the cart readings over samples k0+1..k1 from the start state ``s``."""
+    sq = 0.0
+    reading = s[0]
+    for k in range(k0, k1):
+        s, mode, dr = _sample(pp, fp, ef, deadzone, saturation, drive, first, durations, commands, k, s, mode, dr,
+                              substep, forced, theta_bias, pendulum)
+        if not math.isfinite(s[0]):
+            return math.inf
+        reading = play(reading, s[0], gap) if gap > 0.0 else s[0]
+        sq += (reading - xm[k + 1]) ** 2
+    return sq
+
+
+@compiled
+def _start_rate(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, first, durations, commands, k0, k1,
+                s, mode, dr, substep, forced, pendulum, xm, step):
+    """The cart's start rate [m/s] and mode that best replay readings k0+1..k1 (START_FIT_S): the local
+    fit's rate ``s[2]`` plus START_RATES times ``step`` [m/s], then the vertex of the parabola through
+    the best one and its neighbours where it lowers the error; or at rest, held by static friction (a
+    cart that stops and starts again within the local fit's span), where that replays them best."""
+    n = len(START_RATES)
+    costs = np.empty(n)
+    for i in range(n):
+        costs[i] = _start_cost(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, first, durations,
+                               commands, k0, k1, (s[0], s[1], s[2] + START_RATES[i] * step, s[3], s[4]), mode,
+                               dr, substep, forced, pendulum, xm)
+    b = int(np.argmin(costs))
+    best, cost = s[2] + START_RATES[b] * step, costs[b]
+    if 0 < b < n - 1:
+        x0, x1, x2 = START_RATES[b - 1], START_RATES[b], START_RATES[b + 1]
+        c0, c1, c2 = costs[b - 1], costs[b], costs[b + 1]
+        den = (x1 - x0) * (c1 - c2) - (x1 - x2) * (c1 - c0)
+        if den != 0.0:
+            x = x1 - 0.5 * ((x1 - x0) ** 2 * (c1 - c2) - (x1 - x2) ** 2 * (c1 - c0)) / den
+            v = s[2] + x * step
+            c = _start_cost(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, first, durations, commands,
+                            k0, k1, (s[0], s[1], v, s[3], s[4]), mode, dr, substep, forced, pendulum, xm)
+            if c < cost:
+                best, cost = v, c
+    at_rest = (1.0, mode[1], mode[2])
+    c = _start_cost(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, first, durations, commands, k0, k1,
+                    (s[0], s[1], 0.0, s[3], s[4]), at_rest, dr, substep, forced, pendulum, xm)
+    if c < cost:
+        return 0.0, at_rest
+    return best, mode
+
+
 @compiled(parallel=True)   # the windows are independent: one thread each
 def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, drive0, t, first, durations, commands,
-           start, stop, state, held, substep, forced, angle, out):
+           start, stop, state, held, substep, forced, angle, xm, fit_n, rate_step, out):
     """Encoder readings (x, theta) predicted in every window, written into ``out`` (n, 2). Each
     sample interval k is integrated over its pieces of constant applied command (``first``,
     ``durations``, ``commands`` of :func:`~ipfric_core.physics.rig.drive_pieces`), each through
-    the input effects. Without a pendulum (pp's m = 0) the angle is held at 0; with ``forced`` (n, 2)
-    rows, the angle and its rate are set to them (less the bias) after every sample; a free angle more
-    than 1.5 rad from the measured one (``angle``) has diverged (the rest of its window is NaN). With a
-    drive play (``drive`` as :func:`~ipfric_core.physics.simulate.advance_drive` takes it, play > 0)
-    each window starts from the drive state ``drive0`` (n_windows, 2+) of :func:`drive_states`."""
+    the input effects (:func:`_sample`). Without a pendulum (pp's m = 0) the angle is held at 0; with
+    ``forced`` (n, 2) rows, the angle and its rate are set to them (less the bias) after every sample;
+    a free angle more than 1.5 rad from the measured one (``angle``) has diverged (the rest of its
+    window is NaN). A window that starts in motion starts at the cart rate (or at rest) that best replays
+    its first ``fit_n`` readings ``xm`` (:func:`_start_rate`, ``rate_step`` [m/s] its scale), unless the
+    model has a drive play (``drive`` as :func:`~ipfric_core.physics.simulate.advance_drive` takes it,
+    play > 0): then each window starts from the drive state ``drive0`` (n_windows, 2+) of
+    :func:`drive_states`, the cart's rate with it."""
     pendulum = pp[1] > 0.0
-    force = len(forced) > 0
     for w in numba.prange(len(start)):
         s = (state[w, 0], state[w, 1] - theta_bias, state[w, 2], state[w, 3], state[w, 4])
         mode = (held[w], 0.0, 0.0)
         dr = (drive0[w, 0], drive0[w, 1])
         reading = s[0]
         k0 = start[w]
+        if held[w] == 0.0 and fit_n > 0 and drive[0] == 0.0:
+            k1 = min(k0 + fit_n, stop[w] - 1)
+            v, mode = _start_rate(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, first, durations,
+                                  commands, k0, k1, s, mode, dr, substep, forced, pendulum, xm, rate_step[w])
+            s = (s[0], s[1], v, s[3], s[4])
         if w == 0 or stop[w - 1] - 1 != k0:
             # the start; where the window before ends on it, that sample is that window's last
             # prediction (written by another thread: not overwritten here)
             out[k0, 0], out[k0, 1] = reading, s[1] + theta_bias
         for k in range(k0, stop[w] - 1):
-            for j in range(first[k], first[k + 1]):
-                v = input_effects(commands[j], deadzone, saturation)
-                if drive[0] > 0.0:
-                    s, mode, dr = advance_drive(pp, fp, ef, s, mode, dr, v, durations[j], substep, drive)
-                else:
-                    s, mode = advance(pp, fp, ef, s, mode, v, durations[j], substep)
-            if force:
-                s = (s[0], forced[k + 1, 0] - theta_bias, s[2], forced[k + 1, 1], s[4])
-            elif not pendulum:
-                s = (s[0], 0.0, s[2], 0.0, s[4])
+            s, mode, dr = _sample(pp, fp, ef, deadzone, saturation, drive, first, durations, commands, k, s, mode,
+                                  dr, substep, forced, theta_bias, pendulum)
             if not (math.isfinite(s[0]) and math.isfinite(s[1])) or abs(s[1] + theta_bias - angle[k + 1]) > 1.5:
                 for j in range(k + 1, stop[w]):
                     out[j, 0], out[j, 1] = np.nan, np.nan
@@ -272,6 +350,10 @@ def predict(model, rec: Record, win: Windows) -> Prediction:
     """Replay ``rec``'s command through ``model`` (an :class:`ident.model.ModelVectors`)."""
     tr = model.truth
     first, durations, commands = pieces(rec, tr.input_delay_s, tr.input_lag_s)
+    # the free pendulum's windows keep the local fit's rates (its angle would pay for a cart rate fitted alone)
+    span = max(3, int(round(START_FIT_S / rec.dt)))
+    fit_n = span if len(win.forced) or rec.theta is None else 0
+    rate_step = np.maximum(np.abs(win.state[:, 2]), START_COUNTS * rec.x_resolution / (span * rec.dt))
     out = np.full((len(rec.t), 2), np.nan)
     drive = tuple(float(v) for v in tr.drive_vector())
     drive0 = (drive_states(model.pp, drive[0], drive[1], rec.t, applied_commands(model, rec), win.motion)[win.start]
@@ -279,7 +361,7 @@ def predict(model, rec: Record, win: Windows) -> Prediction:
     _shoot(model.pp, model.fp, tr.force_vector(), tr.deadzone_V, tr.saturation_V, tr.backlash_m, tr.bias_theta_rad,
            drive, drive0, rec.t, first, durations, commands, win.start, win.stop,
            win.state, win.held, min(1e-3, float(np.median(np.diff(rec.t)))), win.forced,
-           rec.theta if rec.theta is not None else np.zeros(len(rec.t)), out)
+           rec.theta if rec.theta is not None else np.zeros(len(rec.t)), rec.x, fit_n, rate_step, out)
     window_of = np.full(len(rec.t), -1)
     for i, (a, b) in enumerate(zip(win.start, win.stop)):
         window_of[a + 1:b] = i
