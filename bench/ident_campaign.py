@@ -6,12 +6,13 @@ that shares nothing with ipfric_core), each identified by ``ipfric identify`` an
 
 A case's expected answer: the library effect(s) whose own contribution (truth
 ``contribution_counts_rms``: multiple shooting on 1 s windows, cart encoder counts; angle counts
-for ``sensor_bias``) reaches the threshold; ``not_explained`` when only an effect from outside the
-library (spring, friction patch) or a wrong declared plant constant reaches it; ``none`` otherwise.
+for ``sensor_bias``) reaches the threshold, and a wrong declared constant the ladder corrects (M,
+alpha, beta: ``<name> corrected``); ``not_explained`` when only an effect from outside the library
+(spring, friction patch) or a wrong pendulum constant (m, l) reaches it; ``none`` otherwise.
 Below the threshold any answer but a wrong library name is acceptable (recorded as such).
-The answer given: ``result['verdict']`` when the identification writes one (not explained ->
-``not_explained`` unless a library effect was added too), else ``result['effects_added']`` (the
-friction law's parts ``coulomb``, ``stribeck``, ``presliding`` are not effects).
+The answer given: ``result['effects_added']`` (the friction law's parts ``coulomb``, ``stribeck``,
+``presliding`` are not effects) and the constants its ladder corrected; without either,
+``not_explained`` when its verdict says so, else ``none``.
 
 Writes out_dir/summary.json, summary.md and detection.png; out_dir/cases/<case>/ holds the data,
 the truth and the identification's report (``ident/result.json``, ``ident/stderr.txt``).
@@ -38,6 +39,8 @@ from independent import campaign  # noqa: E402
 
 FRICTION_PARTS = {'coulomb', 'stribeck', 'presliding'}
 OUTSIDE = set(campaign.OUTSIDE) | {'plant_error'}
+#: declared constants the ladder tries to correct (ipfric_core.ident.ladder.PLANT_CORRECTIONS)
+CORRECTED = ('M', 'alpha', 'beta')
 THRESHOLD = 2.0          # counts RMS: an effect's contribution from which it must be named
 BINS = (0.0, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 1000.0, math.inf)
 TIMEOUT = 1800.0
@@ -56,7 +59,9 @@ def components(truth: dict) -> list[dict]:
            for k, v in truth['effects'].items()]
     pe = truth.get('plant_error')
     if pe:
-        out.append(dict(name='plant_error', library=False, counts=float(pe['contribution_counts_rms']),
+        known = pe['name'] in CORRECTED
+        out.append(dict(name=f'{pe["name"]} corrected' if known else 'plant_error', library=known,
+                        counts=float(pe['contribution_counts_rms']),
                         detail=f'{pe["name"]} declared x{pe["factor"]:.2f}'))
     return out
 
@@ -74,7 +79,8 @@ def expected_answer(truth: dict, threshold: float = THRESHOLD) -> dict:
 def predicted_answer(result: dict | None) -> dict:
     if result is None:
         return dict(label='error', added=[], verdict=None)
-    added = sorted(e for e in result.get('effects_added', []) if e not in FRICTION_PARTS)
+    added = sorted([e for e in result.get('effects_added', []) if e not in FRICTION_PARTS]
+                   + [s['step'] for s in result.get('ladder', []) if s['step'].endswith(' corrected')])
     verdict = result.get('verdict')
     if added:
         label = '+'.join(added)

@@ -146,9 +146,17 @@ def test_scorer_rules(effects, added, verdict, expected, outcome):
     assert scorer.outcome(exp, scorer.predicted_answer(None)) == 'error'
 
 
-def test_plant_error_above_threshold_expects_not_explained():
+def test_a_wrong_declared_constant_expects_its_correction_or_not_explained():
     truth = _truth((), {'name': 'alpha', 'factor': 0.7, 'contribution_counts_rms': 50.0})
-    assert scorer.expected_answer(truth, 2.0)['label'] == 'not_explained'
+    exp = scorer.expected_answer(truth, 2.0)
+    assert exp['label'] == 'alpha corrected'          # the ladder corrects M, alpha and beta
+    corrected = {'effects_added': [], 'ladder': [{'step': 'declared'}, {'step': 'alpha corrected'}],
+                 'verdict': {'explained': True}}
+    assert scorer.outcome(exp, scorer.predicted_answer(corrected)) == 'correct'
+    refit = {'effects_added': [], 'ladder': [{'step': 'declared'}, {'step': 'refit'}], 'verdict': {'explained': True}}
+    assert scorer.outcome(exp, scorer.predicted_answer(refit)) == 'missed'
+    pendulum = _truth((), {'name': 'l', 'factor': 1.3, 'contribution_counts_rms': 50.0})
+    assert scorer.expected_answer(pendulum, 2.0)['label'] == 'not_explained'   # no correction for m, l
     assert scorer.detection_limit([(1.0, False), (3.0, True), (5.0, True), (9.0, True)]) == 3.0
     assert scorer.detection_limit([(1.0, True), (3.0, False)]) is None
 
