@@ -1,13 +1,14 @@
 """Data as rigs write them: what the loaders take (uneven stamps, overruns, wrapped and
 hanging angles, a byte-order mark, gzip) and what they refuse, by name, with exit code 2."""
 import gzip
+import json
 
 import numpy as np
 import pytest
 
 from ipfric_core.analysis.records import load, overruns, upright_angle
 from ipfric_core.cli import main
-from ipfric_core.physics.params import ConfigError
+from ipfric_core.physics.params import ConfigError, PlantParams
 
 N = 600
 
@@ -193,3 +194,18 @@ def test_columns_that_parse_but_cannot_be_right_are_refused(tmp_path, capsys, ma
         assert code == 0, err
     else:
         assert code == 2 and words in err and 'allowed' in err, err
+
+
+@pytest.mark.parametrize('index', [13, 14])
+def test_a_balancing_loop_whose_angle_equation_is_blurred_is_read_as_written(tmp_path, capsys, index):
+    """Balancing loops of the randomised independent campaign (seed 11: a 35 ms delay, a saturating
+    amplifier) tie the cart to the angle, so that one term of the pendulum's equation takes the declared
+    size when the columns are read the other way round: neither is refused as swapped (both terms must
+    agree for that)."""
+    from independent import campaign
+    campaign.write_case(tmp_path, 11, index, duration=20.0)
+    d = tmp_path / campaign.case_name(index)
+    c = json.loads((d / 'truth.json').read_text())['declared_plant']
+    plant = PlantParams(**{k: c[k] for k in ('M', 'm', 'l', 'alpha', 'beta')})
+    rec = load(d / 'data.csv', plant)
+    assert rec.theta is not None and np.ptp(rec.x) < 0.2       # x read as x: centimetres of travel

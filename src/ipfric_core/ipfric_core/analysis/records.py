@@ -206,21 +206,26 @@ def angle_equation(t, x, theta) -> tuple[np.ndarray, np.ndarray]:
 
 def misread(t, x, theta, l: float, g: float) -> None:
     """Refuse a record whose columns parse but cannot be right, by the pendulum's own equation
-    (:func:`angle_equation`, its terms of the declared pendulum's size): theta in degrees (the gravity
-    term does not change with the angle's unit, the coupling to the cart grows 57.3 times), or x and
-    theta swapped (the gravity term shows only when they are read the other way round)."""
+    (:func:`angle_equation`): theta in degrees (the gravity term of the declared pendulum's size, the
+    coupling to the cart 57.3 times its size), or x and theta swapped (read the other way round, both
+    terms of the declared pendulum's size, and not so as they are). Both terms must agree: in a
+    balancing loop the controller ties the cart to the angle, and one term alone can take the size the
+    other leaves."""
+    def sized(coef, tstat, expected):
+        return abs(tstat) >= CONVENTION_T and 0.6 < abs(coef) / expected < 1.6
     (grav, coupling), (t_grav, t_coupling) = angle_equation(t, x, theta)
-    if abs(t_coupling) >= CONVENTION_T and 0.6 < abs(coupling) / (0.75 / l) / math.degrees(1.0) < 1.6:
+    if sized(grav, t_grav, 0.75 * g / l) and sized(coupling, t_coupling, 0.75 / l * math.degrees(1.0)):
         raise ConfigError(f'columns: theta looks like degrees, not radians: the pendulum\'s coupling to the '
                           f'cart is {abs(coupling):.3g} per unit (t = {abs(t_coupling):.3g}) where the declared '
                           f'pendulum gives {0.75 / l:.3g} per rad; allowed: theta in rad')
-    if abs(t_grav) >= CONVENTION_T and 0.6 < abs(grav) / (0.75 * g / l) < 1.6:
+    if sized(grav, t_grav, 0.75 * g / l) or sized(coupling, t_coupling, 0.75 / l):
         return
-    (grav, _), (t_grav, _) = angle_equation(t, theta, x)
-    if abs(t_grav) >= CONVENTION_T and 0.6 < abs(grav) / (0.75 * g / l) < 1.6:
+    (grav, coupling), (t_grav, t_coupling) = angle_equation(t, theta, x)
+    if sized(grav, t_grav, 0.75 * g / l) and sized(coupling, t_coupling, 0.75 / l):
         raise ConfigError(f'columns: x and theta look swapped: the pendulum\'s equation shows its gravity term '
                           f'(t = {abs(t_grav):.3g}, {abs(grav):.3g} 1/s^2 where the declared pendulum gives '
-                          f'{0.75 * g / l:.3g}) only when they are read the other way round; allowed: x in m, '
+                          f'{0.75 * g / l:.3g}) and its coupling to the cart ({abs(coupling):.3g} per m, '
+                          f'{0.75 / l:.3g} declared) only when they are read the other way round; allowed: x in m, '
                           f'theta in rad (--columns maps them)')
 
 
