@@ -11,7 +11,7 @@ alpha, beta: ``<name> corrected``); ``not_explained`` when only an effect from o
 (spring, friction patch) or a wrong pendulum constant (m, l) reaches it; ``none`` otherwise.
 Below the threshold any answer but a wrong library name is acceptable (recorded as such).
 The answer given: ``result['effects_added']`` (the friction law's parts ``coulomb``, ``stribeck``,
-``presliding`` are not effects) and the constants its ladder corrected; without either,
+``presliding`` are not effects) and ``result['constants_corrected']``; without either,
 ``not_explained`` when its verdict says so, else ``none``.
 
 Writes out_dir/summary.json, summary.md and detection.png; out_dir/cases/<case>/ holds the data,
@@ -80,7 +80,7 @@ def predicted_answer(result: dict | None) -> dict:
     if result is None:
         return dict(label='error', added=[], verdict=None)
     added = sorted([e for e in result.get('effects_added', []) if e not in FRICTION_PARTS]
-                   + [s['step'] for s in result.get('ladder', []) if s['step'].endswith(' corrected')])
+                   + [f'{n} corrected' for n in result.get('constants_corrected', [])])
     verdict = result.get('verdict')
     if added:
         label = '+'.join(added)

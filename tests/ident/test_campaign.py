@@ -150,10 +150,9 @@ def test_a_wrong_declared_constant_expects_its_correction_or_not_explained():
     truth = _truth((), {'name': 'alpha', 'factor': 0.7, 'contribution_counts_rms': 50.0})
     exp = scorer.expected_answer(truth, 2.0)
     assert exp['label'] == 'alpha corrected'          # the ladder corrects M, alpha and beta
-    corrected = {'effects_added': [], 'ladder': [{'step': 'declared'}, {'step': 'alpha corrected'}],
-                 'verdict': {'explained': True}}
+    corrected = {'effects_added': [], 'constants_corrected': ['alpha'], 'verdict': {'explained': True}}
     assert scorer.outcome(exp, scorer.predicted_answer(corrected)) == 'correct'
-    refit = {'effects_added': [], 'ladder': [{'step': 'declared'}, {'step': 'refit'}], 'verdict': {'explained': True}}
+    refit = {'effects_added': [], 'constants_corrected': [], 'verdict': {'explained': True}}
     assert scorer.outcome(exp, scorer.predicted_answer(refit)) == 'missed'
     pendulum = _truth((), {'name': 'l', 'factor': 1.3, 'contribution_counts_rms': 50.0})
     assert scorer.expected_answer(pendulum, 2.0)['label'] == 'not_explained'   # no correction for m, l

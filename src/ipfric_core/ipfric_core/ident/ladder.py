@@ -15,7 +15,8 @@ lowers the validation error most among those that pass every check:
 
 - it lowers the validation simulation error by more than ``SIM_GAIN_PERCENT``, significantly
   (block bootstrap over the validation windows, p < ``P_VALUE``), and the estimation error
-  too, and no reported figure (cart, angle) gets worse by more than ``WORSE_PERCENT``;
+  too, and no reported figure (cart, angle) gets worse by more than ``WORSE_PERCENT`` and
+  ``WORSE_COUNTS``;
 - no fitted parameter ends on a bound;
 - the data do not contradict it: a deadzone below the smallest command that moved the
   cart, a saturation that no steady speed above it refutes, a delay no longer than the
@@ -51,13 +52,14 @@ from . import lsq, shooting
 from .effects import EFFECTS, PARAMS
 from .model import FRICTION_FITTED, LADDER_EFFECTS, LAW_PARAMS, Model
 
-__all__ = ['Problem', 'Step', 'run_ladder', 'verdict']
+__all__ = ['PLANT_CORRECTIONS', 'Problem', 'Step', 'run_ladder', 'verdict']
 
 P_VALUE = 0.01           # a drop is significant below this p-value
 BOOTSTRAP = 2000         # resamples of the windows' drops (:func:`block_p_value`)
 SIM_GAIN_PERCENT = 2.0
 MIN_DROP_COUNTS = 0.05   # and by at least this much RMS [counts] (rounding alone leaves 0.29 count)
 WORSE_PERCENT = 5.0      # a reported figure (cart, angle) may not rise by more (their noise floors move a little)
+WORSE_COUNTS = 0.5       # and by more than this [counts RMS]: an angle error near its floor moves by a few tenths
 MAX_ROUNDS = 4
 #: the friction laws the ladder weighs against each other
 LAWS = ('viscous', 'coulomb', 'exponential', 'dynamic')
@@ -73,6 +75,7 @@ DIFF_STEP = 5e-3
 THETA_WEIGHT = 0.2       # an angle count weighs a fifth of a cart count (errors of the pendulum's start rates grow)
 PRIOR_REL = 0.5         # the declared values' prior standard deviation, relative
 PRIOR_COUNTS = 0.3      # RMS error [counts] that one prior standard deviation is worth
+UNDO_SIGMA = 2.0         # a correction that ends this many standard errors from the declared value or closer is undone
 REFIT_NOTE = 0.3         # a refit that moves a declared value by more than 30 % is reported
 STOP_S = 0.05            # a stretch this long with the encoder still is a stop [s]
 SCREEN_GAIN = 0.01       # an effect whose own parameters lower the estimation cost less is not refitted
@@ -86,6 +89,9 @@ SCREEN_NFEV = 12         # steps of a candidate's short fit
 FULL_SHARE = 0.5         # a candidate is fitted in full when its short fit gains this share of the best one's
 FULL_TOP = 3             # and is among the best FULL_TOP of its group
 REDO_GAIN = 0.1          # a short fit that gains this much on a subset of windows and nothing on all is redone on all
+#: and one that leaves every window this much worse than the model it starts from (its friction levels
+#: wandered off on the subset)
+REDO_LOSS = 0.1
 
 class Problem:
     """A record cut into windows, and the simulation error of a model on it: the cart's
@@ -570,7 +576,8 @@ def short_fit(pe: Problem, current: Model, h: Hypothesis, prior: Model, ps: Prob
     parameters) on the cart's windows of ``ps`` (:meth:`Problem.screen`; the angle's too for an effect on
     the angle), and the share by which it lowers the estimation error of every window of ``pe`` (0 for a
     drive play whose best grid point explains nothing: not fitted). Where the subset's fit does not
-    carry over to every window (it gains REDO_GAIN on the subset, less than SCREEN_GAIN on all), the
+    carry over to every window (it gains REDO_GAIN on the subset, less than SCREEN_GAIN on all, or it
+    leaves all REDO_LOSS worse than ``current``: its friction levels wandered off on the subset), the
     fits are done again on ``pe``; on the subset, the gain is counted from the friction levels refitted
     there alone (:meth:`Problem.baseline`), not from ``current``."""
     starts = [h.model.with_values(s) for s in h.starts]
@@ -589,7 +596,7 @@ def short_fit(pe: Problem, current: Model, h: Hypothesis, prior: Model, ps: Prob
         return best, 1.0 - pr.cost(best) / pr.cost(pr.baseline(current, levels, prior))
     best, gain = fit(ps)
     full = 1.0 - pe.cost(best) / pe.cost(current)
-    if ps is not pe and gain >= REDO_GAIN and full < SCREEN_GAIN:
+    if ps is not pe and full < SCREEN_GAIN and (gain >= REDO_GAIN or full < -REDO_LOSS):
         best, _ = fit(pe)
         full = 1.0 - pe.cost(best) / pe.cost(current)
     return best, full
@@ -698,7 +705,7 @@ def judge(pe: Problem, pv: Problem, current: Model, h: Hypothesis, m: Model, not
         why.append('the estimation error does not drop')
     before, after = pv.summary(current), pv.summary(m)
     for key in ('x_rms_counts', 'theta_rms_counts'):
-        if key in before and after[key] > before[key] * (1 + WORSE_PERCENT / 100):
+        if key in before and after[key] > max(before[key] * (1 + WORSE_PERCENT / 100), before[key] + WORSE_COUNTS):
             why.append(f'validation {key.split("_")[0]} error rises from {before[key]:.3g} to {after[key]:.3g} counts')
     k = len(m.free)
     return Judged(h, m, {}, gain, pval, ev1 * math.exp(2 * k / max(pv.n_windows, 1)), why)
@@ -878,15 +885,40 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
         say(f'kept {win.h.label}: validation x error {steps[-1].val["x_rms_counts"]:.3g} counts'
             + (f'; runner-up {runner.h.label} ({pv.summary(runner.model)["x_rms_counts"]:.3g} counts)'
                if runner else ''))
+    current = undo_corrections(pe, pv, declared, current, steps, say)
     v = verdict(pv, current)
     if not v['explained']:
-        last = rounds[-1]['round']
+        last = rounds[-1]['round'] if rounds else 0
         left = sorted((t for t in tried if t['round'] == last), key=lambda t: -t['validation_gain_percent'])
         v['tried'] = sorted({t['hypothesis'] for t in tried})
         v['largest_left'] = [{'hypothesis': t['hypothesis'], 'validation_gain_percent': t['validation_gain_percent'],
                               'refused': t['refused']} for t in left[:3]]
     say(v['reason'])
     return {'steps': steps, 'tried': tried, 'rounds': rounds, 'verdict': v, 'estimation': est, 'validation': val}
+
+
+def undo_corrections(pe: Problem, pv: Problem, declared: Model, current: Model, steps: list, say) -> Model:
+    """The final model with each plant correction that the data no longer support held at its declared
+    value again: one that a later round's effect took over (a delay read first as a weaker motor) ends
+    within UNDO_SIGMA standard errors of the declared value; held there and the rest refitted, it is
+    undone when the validation error stays within WORSE_PERCENT (a step '<name> as declared')."""
+    std = steps[-1].std
+    for name in PLANT_CORRECTIONS:
+        p = current.param(name)
+        s = std.get(name) if isinstance(std, dict) else None
+        if not p.free or declared.param(name).free or s is None or not math.isfinite(s) \
+                or abs(p.value - declared[name]) > UNDO_SIGMA * s:
+            continue
+        m, s2 = fit_model(pe, current.holding({name: declared[name]}), prior=declared)
+        before, after = pv.summary(current)['x_rms_counts'], pv.summary(m)['x_rms_counts']
+        if after > before * (1 + WORSE_PERCENT / 100) or on_bounds(m):
+            continue
+        note = (f'the data no longer move {name} from its declared {declared[name]:.4g} {p.unit} (the correction '
+                f'ended at {p.value:.4g} +/- {s:.2g} {p.unit}): held there again')
+        steps.append(Step(f'{name} as declared', m, s2, pe.summary(m), pv.summary(m), [note]))
+        say(f'{name} as declared: validation x error {after:.3g} counts (with the correction {before:.3g})')
+        current = m
+    return current
 
 
 def _alternative(j: Judged, pv: Problem) -> dict:

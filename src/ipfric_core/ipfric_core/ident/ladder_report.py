@@ -17,7 +17,7 @@ from ..analysis.records import smooth_rate  # noqa: E402
 from ..physics.friction import friction_force  # noqa: E402
 from . import shooting  # noqa: E402
 from .effects import PARAMS  # noqa: E402
-from .ladder import Problem, Step  # noqa: E402
+from .ladder import PLANT_CORRECTIONS, Problem, Step  # noqa: E402
 
 __all__ = ['correlation_lines', 'write_ladder_report']
 
@@ -166,6 +166,7 @@ def ladder_result(res: dict) -> dict:
                     'friction_at_speeds': friction_curve(s, at), 'notes': s.notes + coverage_note(s, at)}
                    for s in steps],
         'effects_added': list(steps[-1].model.effects),
+        'constants_corrected': [n for n in PLANT_CORRECTIONS if steps[-1].model.param(n).free],
         'verdict': res['verdict'],
         'rounds': res['rounds'],
         'effects_tried': res['tried'],
@@ -197,7 +198,8 @@ def ladder_markdown(r: dict) -> str:
         lines.append(f'| {s["step"]} | {e["x_rms_counts"]:.3g} | {v["x_rms_counts"]:.3g} | {v["x_percent"]:.3g} '
                      f'| {th} |')
     v = r['verdict']
-    lines += ['', f'Effects added: {", ".join(r["effects_added"]) or "none"}.', '', f'**Verdict**: {v["reason"]}.', '']
+    lines += ['', f'Effects added: {", ".join(r["effects_added"]) or "none"}; constants corrected: '
+              f'{", ".join(r["constants_corrected"]) or "none"}.', '', f'**Verdict**: {v["reason"]}.', '']
     if not v['explained']:
         lines += ['Tried: ' + ', '.join(v.get('tried', [])) + '.', '',
                   'The largest signatures left (the hypotheses of the last round that lowered the validation '
