@@ -294,6 +294,32 @@ def bench_identify(quick: bool) -> list[dict]:
     return rows
 
 
+def bench_campaign(quick: bool, n_cases: int, seed: int = 1) -> list[dict]:
+    """The randomised identification campaign (bench/ident_campaign.py: cases drawn by independent code,
+    each through ./ipfric identify), its confusion matrix in runs/bench-campaign/summary.md."""
+    from bench import ident_campaign
+    n = 1 if quick else n_cases
+    out = REPO_ROOT / 'runs' / ('bench-campaign-quick' if quick else 'bench-campaign')
+    shutil.rmtree(out, ignore_errors=True)
+    t0 = time.perf_counter()
+    s = ident_campaign.run_campaign(out, n, seed, progress=lambda msg: print(msg, file=sys.stderr))
+    tg = ident_campaign.targets(s)
+    share = tg['right_share_above_limit']
+    met = (n >= 200 and share is not None and share >= 0.95 and (tg['clean_share_anything_added'] or 0.0) <= 0.02
+           and tg['outside_under_library_name'] == 0)
+    cases = f'{n} case{"s" if n != 1 else ""}'
+    return [{'benchmark': f'identification campaign: {cases} of independent code (seed {seed}), '
+                          f'confusion matrix in {out.relative_to(REPO_ROOT)}/summary.md',
+             'reference': 'the truth each case was drawn with',
+             'ipfric': f'right {tg["right_above_limit"]} of {tg["above_limit"]} above the detection limits; clean '
+                       f'with anything added {100 * (tg["clean_share_anything_added"] or 0.0):.3g} %; outside the '
+                       f'library: {tg["outside_not_explained"]} of {tg["outside"]} not explained, '
+                       f'{tg["outside_under_library_name"]} under a library name; {time.perf_counter() - t0:.0f} s',
+             'ratio': share, 'target': '>= 200 cases; >= 95 % right above the limits, <= 2 % of clean cases with '
+                                       'anything added, none from outside the library under a library name',
+             'met': met}]
+
+
 # ----------------------------------------------------------------------------------- orbits
 def bench_orbit(quick: bool) -> list[dict]:
     """./ipfric orbit on Figure 7 (exact sensors): one orbit beside the 120 s run whose cycle it
@@ -379,7 +405,7 @@ def table(rows, quick) -> str:
 
 
 def run_all(quick: bool = False, realtime_s: float = 600.0, results: Path | None = None,
-            progress=print) -> dict:
+            progress=print, campaign_cases: int = 200) -> dict:
     """Run every benchmark; write the table with the machine's description to ``results``."""
     info = machine()
     rows = []
@@ -396,6 +422,8 @@ def run_all(quick: bool = False, realtime_s: float = 600.0, results: Path | None
     rows += bench_analyze(bag, work / 'lockstep' / 'bag', (2.0 if quick else realtime_s) / 60)
     progress('[bench] identify ...')
     rows += bench_identify(quick)
+    progress(f'[bench] identification campaign ({1 if quick else campaign_cases} cases) ...')
+    rows += bench_campaign(quick, campaign_cases)
     info['load_average_at_end'] = os.getloadavg()
     text = table(rows, quick)
     if results is not None:
@@ -414,16 +442,22 @@ def run_all(quick: bool = False, realtime_s: float = 600.0, results: Path | None
 
 
 def main(argv=None) -> int:
-    """``python -m bench.run [--quick] [--realtime-duration S] [--results FILE] [--json]`` (what
+    """``python -m bench.run [--quick] [--realtime-duration S] [--campaign-cases N] [--results FILE] [--json]`` (what
     ``./ipfric bench`` runs): the table on stdout, or the whole result as JSON."""
     import argparse
     p = argparse.ArgumentParser(prog='python -m bench.run', description=main.__doc__)
     p.add_argument('--quick', action='store_true')
     p.add_argument('--realtime-duration', type=float, default=600.0)
+    p.add_argument('--campaign-cases', type=int, default=200,
+                   help='cases of the identification campaign (default 200: about two hours on two cores; '
+                        '--quick: one)')
     p.add_argument('--results', type=Path, required=True)
     p.add_argument('--json', action='store_true')
     a = p.parse_args(argv)
-    out = run_all(a.quick, a.realtime_duration, a.results, progress=lambda msg: print(msg, file=sys.stderr))
+    if a.campaign_cases < 1:
+        p.error(f'--campaign-cases: {a.campaign_cases} is out of range; allowed: 1 or more')
+    out = run_all(a.quick, a.realtime_duration, a.results, progress=lambda msg: print(msg, file=sys.stderr),
+                  campaign_cases=a.campaign_cases)
     if a.json:
         print_json(out)
     else:

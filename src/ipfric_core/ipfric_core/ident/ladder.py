@@ -324,7 +324,10 @@ def stops_and_starts(rec: Record) -> list[tuple[int, int]]:
 def smallest_moving_command(rec: Record) -> float | None:
     """The command that moved the cart from rest [V]: the largest |command| over the 5 ms before
     each breakaway, its 10th percentile over the breakaways. A deadzone must be below it (a
-    larger one would have kept the cart still)."""
+    larger one would have kept the cart still). None with a pendulum attached: its swing moves the
+    cart with no command at all."""
+    if rec.theta is not None:
+        return None
     vals = []
     for still, _ in stops_and_starts(rec):
         lo = np.searchsorted(rec.t, rec.t[still] - 0.005)
