@@ -96,13 +96,31 @@ def predicted_answer(result: dict | None) -> dict:
     return dict(label=label, added=added, verdict=verdict)
 
 
+#: effects that act alike and are told apart only by a small part: a friction level (1 + a) Fc forward and
+#: (1 - a) Fc backward is Fc plus a constant force -a Fc while the cart slides; only a (Fs - Fc) (the
+#: Stribeck part, the static levels) tells the direction dependence from an offset
+ALIKE = ({'asymmetry', 'offset'},)
+
+
+#: the outcomes counted right
+RIGHT = ('correct', 'alike', 'acceptable')
+
+
+def _kind(name: str) -> str:
+    return next(('/'.join(sorted(g)) for g in ALIKE if name in g), name)
+
+
 def outcome(expected: dict, predicted: dict) -> str:
-    """correct | acceptable (below threshold) | partial | false_positive | missed | wrong | error."""
+    """correct | alike (an effect that acts alike named: :data:`ALIKE`) | acceptable (below threshold) |
+    partial | false_positive | missed | wrong | error."""
     e, p = expected['label'], predicted['label']
     if p == 'error':
         return 'error'
     if p == e:
         return 'correct'
+    if expected['library'] and predicted['added'] and \
+            sorted(map(_kind, predicted['added'])) == sorted(map(_kind, expected['library'])):
+        return 'alike'
     if e == 'none':
         if expected['clean']:
             return 'false_positive'
@@ -245,8 +263,10 @@ def summarize(cases: list[dict], threshold: float, meta: dict) -> dict:
     per_effect = defaultdict(list)        # name -> [(counts, named right, answer)]
     for c in cases:
         for comp in c['components']:
+            if comp.get('equivalent'):
+                continue
             if comp['library']:
-                ok = comp['name'] in c['added']
+                ok = _kind(comp['name']) in map(_kind, c['added'])
             else:
                 ok = c['predicted'] == 'not_explained'
             per_effect[comp['name']].append((comp['counts'], ok, c['predicted'], c['case']))
@@ -275,12 +295,12 @@ def summarize(cases: list[dict], threshold: float, meta: dict) -> dict:
         floors = [c['oracle_counts']['x_rms_counts'] for c in same
                   if c.get('oracle_counts') and 'x_rms_counts' in c['oracle_counts']]
         by_setting[f'{key[0]} / {key[1]}'] = dict(
-            n=len(same), right=sum(c['outcome'] in ('correct', 'acceptable') for c in same),
+            n=len(same), right=sum(c['outcome'] in RIGHT for c in same),
             outcomes=dict(Counter(c['outcome'] for c in same)),
             true_model_counts_median=float(np.median(floors)) if floors else None)
     return dict(
         meta=meta, threshold_counts=threshold, n_cases=len(cases), outcomes=dict(outcomes),
-        right_share=(outcomes['correct'] + outcomes['acceptable']) / max(1, len(cases)),
+        right_share=sum(outcomes[k] for k in RIGHT) / max(1, len(cases)),
         confusion={k: dict(v) for k, v in sorted(confusion.items())},
         clean=dict(n=len(clean), anything_added=sum(1 for c in clean if c['added']),
                    not_explained=sum(1 for c in clean if c['predicted'] == 'not_explained'),
@@ -309,8 +329,9 @@ def targets(s: dict) -> dict:
         for comp in c['components'] if comp['library'])]
     outside = [c for c in s['cases'] if c['expected'] == 'not_explained']
     return dict(
-        above_limit=len(above), right_above_limit=sum(c['outcome'] == 'correct' for c in above),
-        right_share_above_limit=(sum(c['outcome'] == 'correct' for c in above) / len(above)) if above else None,
+        above_limit=len(above), right_above_limit=sum(c['outcome'] in ('correct', 'alike') for c in above),
+        right_share_above_limit=(sum(c['outcome'] in ('correct', 'alike') for c in above) / len(above))
+        if above else None,
         clean_share_anything_added=s['clean']['share_anything_added'],
         outside=len(outside), outside_not_explained=sum(c['predicted'] == 'not_explained' for c in outside),
         outside_under_library_name=sum(bool(c['added']) for c in outside))
@@ -324,7 +345,7 @@ def write_markdown(s: dict, path: Path) -> None:
     tg = targets(s)
     L = [f'# Identification campaign: {s["n_cases"]} cases, seed {s["meta"].get("seed")}', '',
          f'Threshold {s["threshold_counts"]:g} counts RMS (an effect at or above it must be named). '
-         f'Right (correct or acceptable): {100 * s["right_share"]:.0f} %. Outcomes: '
+         f'Right (correct, alike or acceptable): {100 * s["right_share"]:.0f} %. Outcomes: '
          + ', '.join(f'{k} {v}' for k, v in sorted(s['outcomes'].items())) + '.', '',
          f'Against the targets: right {tg["right_above_limit"]} of {tg["above_limit"]} cases whose library effects '
          f'reach their detection limits; clean cases with anything added: '

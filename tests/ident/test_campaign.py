@@ -136,6 +136,8 @@ def _truth(effects=(), plant_error=None):
     ((('spring', 40.0),), ['offset'], {'explained': False}, 'not_explained', 'wrong'),
     ((('spring', 40.0),), [], {'explained': True}, 'not_explained', 'missed'),
     ((('cogging', 9.0), ('delay', 5.0)), ['cogging'], None, 'cogging+delay', 'partial'),
+    ((('asymmetry', 9.0),), ['offset'], None, 'asymmetry', 'alike'),     # alike while the cart slides
+    ((('asymmetry', 9.0),), ['cogging'], None, 'asymmetry', 'wrong'),
 ])
 def test_scorer_rules(effects, added, verdict, expected, outcome):
     truth = _truth(effects)

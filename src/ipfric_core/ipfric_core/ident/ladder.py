@@ -714,6 +714,22 @@ def judge(pe: Problem, pv: Problem, current: Model, h: Hypothesis, m: Model, not
     return Judged(h, m, {}, gain, pval, ev1 * math.exp(2 * k / max(pv.n_windows, 1)), why)
 
 
+def leaner_first(passing: list[Judged], pv: Problem) -> list[Judged]:
+    """``passing`` (best score first) with a leaner explanation moved ahead of the best one when the best
+    one's extra parameters lower the validation error by less than SIM_GAIN_PERCENT (the dynamic law's
+    bristles for 1 % over the refit: each added parameter must earn the gain an effect must)."""
+    if len(passing) < 2:
+        return passing
+    best = passing[0]
+    err = pv.summary(best.model)['x_rms_counts']
+    lean = [j for j in passing[1:] if len(j.model.free) < len(best.model.free)
+            and pv.summary(j.model)['x_rms_counts'] * (1 - SIM_GAIN_PERCENT / 100) <= err]
+    if not lean:
+        return passing
+    first = min(lean, key=lambda j: (len(j.model.free), j.score))
+    return [first] + [j for j in passing if j is not first]
+
+
 def confirm(pe: Problem, pv: Problem, current: Model, j: Judged, prior: Model) -> None:
     """The checks of a hypothesis that passed :func:`judge` which need its standard errors (its size told
     from zero, a Coulomb level told from zero) and its contribution to the simulated motion; the reasons
@@ -849,7 +865,7 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
         judged = []
         for h, (m, _), note in zip(hs, short, notes):
             judged.append(judge(pe, pv, current, h, full_fit(pe, h, m, declared) if note is None else m, note, sse0_v))
-        passing = sorted((j for j in judged if not j.refused), key=lambda j: j.score)
+        passing = leaner_first(sorted((j for j in judged if not j.refused), key=lambda j: j.score), pv)
         ok = []
         for j in passing:            # the standard errors of the best ones, until two pass
             confirm(pe, pv, current, j, declared)
