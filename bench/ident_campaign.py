@@ -40,7 +40,7 @@ from independent import campaign  # noqa: E402
 FRICTION_PARTS = {'coulomb', 'stribeck', 'presliding'}
 OUTSIDE = set(campaign.OUTSIDE) | {'plant_error'}
 #: declared constants the ladder tries to correct (ipfric_core.ident.ladder.PLANT_CORRECTIONS)
-CORRECTED = ('M', 'alpha', 'beta')
+CORRECTED = ('M', 'alpha')
 #: a wrong declared constant that a fitted friction parameter takes over exactly: the back-EMF beta and
 #: the viscous slope eps act as one (F = alpha V - (beta + eps) x'), so the refit explains it and no
 #: answer about it is wrong
@@ -63,7 +63,7 @@ def components(truth: dict) -> list[dict]:
            for k, v in truth['effects'].items()]
     pe = truth.get('plant_error')
     if pe:
-        known = pe['name'] in CORRECTED
+        known = pe['name'] in CORRECTED or pe['name'] in EQUIVALENT
         out.append(dict(name=f'{pe["name"]} corrected' if known else 'plant_error', library=known,
                         counts=float(pe['contribution_counts_rms']), equivalent=pe['name'] in EQUIVALENT,
                         detail=f'{pe["name"]} declared x{pe["factor"]:.2f}'))

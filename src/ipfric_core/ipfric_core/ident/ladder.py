@@ -9,7 +9,8 @@ reach of what the encoders' rounding alone leaves (:func:`verdict`) or nothing p
 hypothesis competes against the current model (:func:`hypotheses`): its friction refitted
 (known constants frozen unless freed by name: a freed one is fitted first, whatever the
 verdict), each other friction law (viscous, coulomb, exponential, dynamic with its bristle
-starts), each plant correction (M, alpha, beta), each library effect with the friction levels
+starts), each plant correction (M, alpha: a wrong back-EMF beta is the viscous slope eps's to take,
+F = alpha V - (beta + eps) x'), each library effect with the friction levels
 refitted and, before any refit, on the declared friction alone. A round keeps the one that
 lowers the validation error most among those that pass every check:
 
@@ -63,8 +64,9 @@ WORSE_COUNTS = 0.5       # and by more than this [counts RMS]: an angle error ne
 MAX_ROUNDS = 4
 #: the friction laws the ladder weighs against each other
 LAWS = ('viscous', 'coulomb', 'exponential', 'dynamic')
-#: the declared plant constants the ladder may correct (an effective mass with the rotor reflected, the motor)
-PLANT_CORRECTIONS = ('M', 'alpha', 'beta')
+#: the declared plant constants the ladder may correct (an effective mass with the rotor reflected, the motor's
+#: force per volt); not the back-EMF beta: it acts on the cart as the viscous slope eps does, which every law fits
+PLANT_CORRECTIONS = ('M', 'alpha')
 CONTRIBUTION_COUNTS = 2.0  # a kept hypothesis changes the simulated motion by this much at least [counts RMS]
 #: the data are explained when the error is within this factor of what the encoders' rounding alone
 #: leaves, plus this many counts
@@ -554,7 +556,7 @@ def hypotheses(pe: Problem, current: Model, declared: Model, allowed=None) -> li
             out.append(Hypothesis(f'law {other}', 'law', m, LAW_PARAMS[other], LAW_PARAMS[other],
                                   bristle_starts(m) if other == 'dynamic' else [{}]))
     for name in PLANT_CORRECTIONS:
-        if not current.param(name).free and not (name == 'beta' and current[name] == 0.0):
+        if not current.param(name).free:
             out.append(Hypothesis(f'{name} corrected', 'plant', current.with_free((name,) + law), (name,),
                                   (name,) + levels))
     refitted = current.fitted(law)
