@@ -204,6 +204,12 @@ def angle_equation(t, x, theta) -> tuple[np.ndarray, np.ndarray]:
     return coef, coef / np.sqrt(np.maximum(np.diag(cov), 1e-300))
 
 
+def sized(coef: float, tstat: float, expected: float) -> bool:
+    """A term of the pendulum's equation shows: significant (t >= CONVENTION_T) and of the size the
+    declared pendulum gives it (0.6-1.6 times ``expected``)."""
+    return abs(tstat) >= CONVENTION_T and 0.6 < abs(coef) / expected < 1.6
+
+
 def misread(t, x, theta, l: float, g: float) -> None:
     """Refuse a record whose columns parse but cannot be right, by the pendulum's own equation
     (:func:`angle_equation`): theta in degrees (the gravity term of the declared pendulum's size, the
@@ -211,8 +217,6 @@ def misread(t, x, theta, l: float, g: float) -> None:
     terms of the declared pendulum's size, and not so as they are). Both terms must agree: in a
     balancing loop the controller ties the cart to the angle, and one term alone can take the size the
     other leaves."""
-    def sized(coef, tstat, expected):
-        return abs(tstat) >= CONVENTION_T and 0.6 < abs(coef) / expected < 1.6
     (grav, coupling), (t_grav, t_coupling) = angle_equation(t, x, theta)
     if sized(grav, t_grav, 0.75 * g / l) and sized(coupling, t_coupling, 0.75 / l * math.degrees(1.0)):
         raise ConfigError(f'columns: theta looks like degrees, not radians: the pendulum\'s coupling to the '
@@ -246,8 +250,8 @@ def upright_angle(t, x, theta, l: float, g: float, zero: str = 'auto') -> tuple[
     (grav, coupling), (t_grav, t_coupling) = angle_equation(t, x, th)
     # the raw column's coefficients are (c a, s c b) for the reading s * column + (pi if c < 0): a > 0, b < 0;
     # a term decides when it is significant and of the size the declared pendulum gives it (0.6-1.6x)
-    shows_gravity = abs(t_grav) >= CONVENTION_T and 0.6 < abs(grav) / (0.75 * g / l) < 1.6
-    shows_coupling = abs(t_coupling) >= CONVENTION_T and 0.6 < abs(coupling) / (0.75 / l) < 1.6
+    shows_gravity = sized(grav, t_grav, 0.75 * g / l)
+    shows_coupling = sized(coupling, t_coupling, 0.75 / l)
     if zero == 'auto':
         misread(t, x, th, l, g)
     turns = np.round(np.median(th) / (2 * np.pi))
