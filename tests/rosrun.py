@@ -89,15 +89,19 @@ def started(log: Path, proc, timeout: float = 120.0) -> None:
 
 
 @contextmanager
-def run_beside_peer(config, out: Path, name: str, **kwargs):
-    """A :class:`Run` of ``config`` and, once its simulator started, a :class:`Peer` ``name`` in the
-    run's domain; both ended however the block ends. Yields (run, peer)."""
+def run_beside_peer(config, out: Path, name: str, peer_first: bool = False, **kwargs):
+    """A :class:`Run` of ``config`` and, once its simulator started (``peer_first``: before its nodes
+    start, so that the peer has discovered them by sample 0), a :class:`Peer` ``name`` in the run's
+    domain; both ended however the block ends. Yields (run, peer)."""
     r = Run(config, out, timeout=300, **kwargs)
-    r.start()
     peer = None
     try:
+        if peer_first:
+            r.prepare()
+            peer = Peer(name, domain=r.domain)
+        r.start()
         started(r.logs['sim_node'], r.procs['sim_node'])
-        peer = Peer(name, domain=r.domain)
+        peer = peer or Peer(name, domain=r.domain)
         yield r, peer
     finally:
         if peer is not None:

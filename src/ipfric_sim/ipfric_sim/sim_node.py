@@ -24,7 +24,7 @@ command, a command for another sample (lockstep) or from another publisher than 
 controller (the node ``controller_node`` of this namespace, recognised by the publisher of
 each message, :class:`ipfric_ros.identity.Publishers`) gives 0 V and is counted
 (BAD_COMMAND: the first of a burst at once, then one summary per second with counts); no
-valid command for ``watchdog_samples`` samples, or for a second of wall time in lockstep,
+valid command for ``watchdog_samples`` samples, or for 2 s of wall time in lockstep,
 gives 0 V (WATCHDOG, with STALL when the controller stopped answering); another node
 publishing on a topic of the rig is named (INTRUDER). Commands
 are taken with a deadline: a flood cannot hold a sample. The run ends on TRACK_LIMIT,

@@ -309,6 +309,7 @@ class Run:
         self.namespace = namespace
         self.time_mode = time_mode
         self.lock: DomainLock | None = None
+        self.scenario: Path | None = None     # OUT/scenario.yaml, once prepared
         self.signalled_sim = False      # the runner asked the simulator to stop
         self.timeout = timeout
         self.grace = grace
@@ -323,7 +324,8 @@ class Run:
     # -- start -----------------------------------------------------------------------------
     def prepare(self) -> Path:
         """Validate the arguments and the scenario, hold the run's ROS domain, then write
-        OUT/scenario.yaml (raises ConfigError, nothing written and no domain held)."""
+        OUT/scenario.yaml (raises ConfigError, nothing written and no domain held). :meth:`start`
+        prepares a run not prepared yet."""
         self.namespace = check_namespace(self.namespace)
         if self.timeout is not None and not (math.isfinite(self.timeout) and self.timeout > 0):
             raise ConfigError(f'--timeout: {self.timeout!r} must be > 0 wall seconds')
@@ -339,13 +341,14 @@ class Run:
         self.lock = claim_domain(self.domain, self.namespace)
         self.domain = self.lock.domain
         try:
-            return write_run_scenario(self.config, self.out, overrides, self.namespace)
+            self.scenario = write_run_scenario(self.config, self.out, overrides, self.namespace)
         except BaseException:
             self.lock.release()
             raise
+        return self.scenario
 
     def start(self) -> None:
-        cfg = self.prepare()
+        cfg = self.scenario or self.prepare()
         assert self.lock is not None and self.namespace is not None
         env = ros_environment(self.lock.domain)
         logdir = self.out / 'logs'
