@@ -210,14 +210,14 @@ def sized(coef: float, tstat: float, expected: float) -> bool:
     return abs(tstat) >= CONVENTION_T and 0.6 < abs(coef) / expected < 1.6
 
 
-def misread(t, x, theta, l: float, g: float) -> None:
+def misread(t, x, theta, l: float, g: float, equation: tuple) -> None:
     """Refuse a record whose columns parse but cannot be right, by the pendulum's own equation
-    (:func:`angle_equation`): theta in degrees (the gravity term of the declared pendulum's size, the
-    coupling to the cart 57.3 times its size), or x and theta swapped (read the other way round, both
-    terms of the declared pendulum's size, and not so as they are). Both terms must agree: in a
-    balancing loop the controller ties the cart to the angle, and one term alone can take the size the
-    other leaves."""
-    (grav, coupling), (t_grav, t_coupling) = angle_equation(t, x, theta)
+    (``equation``: :func:`angle_equation` of the columns as read): theta in degrees (the gravity term
+    of the declared pendulum's size, the coupling to the cart 57.3 times its size), or x and theta
+    swapped (read the other way round, both terms of the declared pendulum's size, and not so as they
+    are). Both terms must agree: in a balancing loop the controller ties the cart to the angle, and
+    one term alone can take the size the other leaves."""
+    (grav, coupling), (t_grav, t_coupling) = equation
     if sized(grav, t_grav, 0.75 * g / l) and sized(coupling, t_coupling, 0.75 / l * math.degrees(1.0)):
         raise ConfigError(f'columns: theta looks like degrees, not radians: the pendulum\'s coupling to the '
                           f'cart is {abs(coupling):.3g} per unit (t = {abs(t_coupling):.3g}) where the declared '
@@ -247,13 +247,14 @@ def upright_angle(t, x, theta, l: float, g: float, zero: str = 'auto') -> tuple[
     th = np.unwrap(theta)
     if np.any(np.abs(np.diff(theta)) > np.pi):
         notes.append('angle wrapped at +/-pi: unwrapped')
-    (grav, coupling), (t_grav, t_coupling) = angle_equation(t, x, th)
+    equation = angle_equation(t, x, th)
+    (grav, coupling), (t_grav, t_coupling) = equation
     # the raw column's coefficients are (c a, s c b) for the reading s * column + (pi if c < 0): a > 0, b < 0;
     # a term decides when it is significant and of the size the declared pendulum gives it (0.6-1.6x)
     shows_gravity = sized(grav, t_grav, 0.75 * g / l)
     shows_coupling = sized(coupling, t_coupling, 0.75 / l)
     if zero == 'auto':
-        misread(t, x, th, l, g)
+        misread(t, x, th, l, g, equation)
     turns = np.round(np.median(th) / (2 * np.pi))
     far = np.median(np.abs(th - 2 * np.pi * turns)) > np.pi / 2
     if zero == 'auto' and shows_gravity:
