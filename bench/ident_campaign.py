@@ -78,7 +78,7 @@ def expected_answer(truth: dict, threshold: float = THRESHOLD) -> dict:
     below = sorted(c['name'] for c in comps if c['counts'] < threshold or c.get('equivalent'))
     label = '+'.join(above) if above else ('not_explained' if outside else 'none')
     return dict(label=label, library=above, outside=outside, below=below,
-                clean=not comps)
+                clean=not comps, pendulum=truth.get('pendulum_attached', True))
 
 
 def predicted_answer(result: dict | None) -> dict:
@@ -100,14 +100,20 @@ def predicted_answer(result: dict | None) -> dict:
 #: (1 - a) Fc backward is Fc plus a constant force -a Fc while the cart slides; only a (Fs - Fc) (the
 #: Stribeck part, the static levels) tells the direction dependence from an offset
 ALIKE = ({'asymmetry', 'offset'},)
+#: on the cart alone the data fix M / alpha only ((M / alpha) x'' = V - ((beta + eps) / alpha) x' - F / alpha):
+#: a wrong alpha answered with M corrected (the friction scaled with it) is the same model, and the reverse
+CART_ALIKE = ({'M corrected', 'alpha corrected'},)
 
 
 #: the outcomes counted right
 RIGHT = ('correct', 'alike', 'acceptable')
 
 
-def _kind(name: str) -> str:
-    return next(('/'.join(sorted(g)) for g in ALIKE if name in g), name)
+def _kind(name: str, pendulum: bool = True) -> str:
+    """The name of the group of answers that act alike (:data:`ALIKE`, :data:`CART_ALIKE` without a
+    pendulum) that ``name`` belongs to, else ``name``."""
+    groups = ALIKE if pendulum else ALIKE + CART_ALIKE
+    return next(('/'.join(sorted(g)) for g in groups if name in g), name)
 
 
 def outcome(expected: dict, predicted: dict) -> str:
@@ -119,7 +125,8 @@ def outcome(expected: dict, predicted: dict) -> str:
     if p == e:
         return 'correct'
     if expected['library'] and predicted['added'] and \
-            sorted(map(_kind, predicted['added'])) == sorted(map(_kind, expected['library'])):
+            sorted(_kind(n, expected['pendulum']) for n in predicted['added']) == \
+            sorted(_kind(n, expected['pendulum']) for n in expected['library']):
         return 'alike'
     if e == 'none':
         if expected['clean']:
@@ -266,7 +273,8 @@ def summarize(cases: list[dict], threshold: float, meta: dict) -> dict:
             if comp.get('equivalent'):
                 continue
             if comp['library']:
-                ok = _kind(comp['name']) in map(_kind, c['added'])
+                pendulum = c['expected_detail'].get('pendulum', True)
+                ok = _kind(comp['name'], pendulum) in [_kind(n, pendulum) for n in c['added']]
             else:
                 ok = c['predicted'] == 'not_explained'
             per_effect[comp['name']].append((comp['counts'], ok, c['predicted'], c['case']))

@@ -158,6 +158,10 @@ def test_a_wrong_declared_constant_expects_its_correction_or_not_explained():
     assert scorer.outcome(exp, scorer.predicted_answer(refit)) == 'missed'
     emf = _truth((('deadzone', 30.0),), {'name': 'beta', 'factor': 0.7, 'contribution_counts_rms': 900.0})
     assert scorer.expected_answer(emf, 2.0)['label'] == 'deadzone'   # eps takes a wrong beta over exactly
+    as_m = {'effects_added': [], 'constants_corrected': ['M'], 'verdict': {'explained': True}}
+    assert scorer.outcome(exp, scorer.predicted_answer(as_m)) == 'wrong'      # a pendulum on the cart tells them
+    cart = dict(truth, pendulum_attached=False)         # the cart alone fixes M / alpha only
+    assert scorer.outcome(scorer.expected_answer(cart, 2.0), scorer.predicted_answer(as_m)) == 'alike'
     pendulum = _truth((), {'name': 'l', 'factor': 1.3, 'contribution_counts_rms': 50.0})
     assert scorer.expected_answer(pendulum, 2.0)['label'] == 'not_explained'   # no correction for m, l
     assert scorer.detection_limit([(1.0, False), (3.0, True), (5.0, True), (9.0, True)]) == 3.0

@@ -159,5 +159,9 @@ def test_free_constant_is_refitted_only_when_asked(tmp_path, clean, capsys):
     r = json.loads(capsys.readouterr().out)
     m = {p['name']: p for p in r['ladder'][1]['params']}['M']
     assert m['fitted'] and m['value'] == pytest.approx(PLANT.M, rel=0.03)
+    # the cart alone fixes M / alpha only: the same motion read as alpha, M held as declared
+    other = next(n for n in r['ladder'][1]['notes'] if 'M / alpha only' in n)
+    alpha = float(other.split('alpha = ')[1].split(' ')[0])
+    assert alpha == pytest.approx(PLANT.alpha * PLANT.M / m['value'], rel=1e-3), other
     assert main(['identify', str(csv), '--free', 'colour', '--out', str(tmp_path)]) == 2
     assert 'colour' in capsys.readouterr().err

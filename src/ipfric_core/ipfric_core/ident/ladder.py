@@ -795,9 +795,11 @@ class Step:
     notes: list
 
 
-def correction_notes(declared: Model, model: Model, std: dict) -> list[str]:
+def correction_notes(declared: Model, model: Model, std: dict, cart_alone: bool) -> list[str]:
     """A corrected plant constant, as the data say it: 'the declared M is 0.38 kg, the data say 0.52 +/-
-    0.01 kg'."""
+    0.01 kg'. On the cart alone (``cart_alone``), where the data fix M / alpha only (paper eq. 2 without
+    the pendulum, divided by alpha: (M / alpha) x'' = V - ((beta + eps) / alpha) x' - F / alpha), also the
+    other reading of the same ratio: the other constant as declared, the friction scaled with it."""
     out = []
     for name in PLANT_CORRECTIONS:
         p = model.param(name)
@@ -806,6 +808,15 @@ def correction_notes(declared: Model, model: Model, std: dict) -> list[str]:
             err = f' +/- {s:.2g}' if s is not None and math.isfinite(s) else ''
             out.append(f'the declared {name} is {declared[name]:.4g} {p.unit}, the data say {p.value:.4g}{err} '
                        f'{p.unit}')
+    fixed = [n for n in ('M', 'alpha') if not model.param(n).free]
+    if cart_alone and len(fixed) == 1:
+        other, held = fixed[0], 'alpha' if fixed[0] == 'M' else 'M'
+        ratio = (model['M'] / model['alpha']) / (declared['M'] / declared['alpha'])
+        value = declared[other] * (ratio if other == 'M' else 1.0 / ratio)
+        out.append(f'on the cart alone the data fix M / alpha only ({model["M"] / model["alpha"]:.4g} kg V/N, '
+                   f'declared {declared["M"] / declared["alpha"]:.4g}): the same motion is {other} = {value:.4g} '
+                   f'{model.param(other).unit} with {held} as declared, the friction and the viscous term (beta + '
+                   f'eps) times {value / declared[other]:.4g}')
     return out
 
 
@@ -851,7 +862,7 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
         law = LAW_PARAMS[declared.law]
         current, s = fit_model(pe, declared.with_free(law), prior=declared)
         steps.append(Step('refit', current, s, pe.summary(current), pv.summary(current),
-                          correction_notes(declared, current, s) + refit_notes(declared, current)))
+                          correction_notes(declared, current, s, est.theta is None) + refit_notes(declared, current)))
         say(f'refit with {", ".join(p.name for p in declared.free)}: validation x error '
             f'{steps[-1].val["x_rms_counts"]:.3g} counts')
     tried: list[dict] = []
@@ -895,7 +906,7 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
         if on_bounds(current) or untold(current, s) or pv.cost(current) > pv.cost(win.model):
             current, s = win.model, win.std
         label = {'friction': 'refit', 'law': win.h.label, 'plant': win.h.label}.get(win.h.kind, f'+ {win.h.effect}')
-        step_notes = correction_notes(declared, current, s) if win.h.kind == 'plant' else []
+        step_notes = correction_notes(declared, current, s, est.theta is None) if win.h.kind == 'plant' else []
         step_notes += refit_notes(declared, current) if win.h.kind in ('friction', 'law', 'plant') else []
         step_notes += [f'{p.name} held at its declared {p.value:.4g} {p.unit}: the refit put it on a bound, the data '
                        'do not determine it' for p in current.params
