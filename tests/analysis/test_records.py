@@ -49,6 +49,10 @@ REFUSED = [
     ('999 V on a 10 V drive', 'volt.csv', '\n'.join(ROWS[:99] + ['0.098,0,999'] + ROWS[100:]) + '\n',
      'column voltage is 999 at row 99; allowed |voltage| <= 100 V'),
     ('time in minutes', 'min.csv', table(t=np.arange(N) * 1e-3 / 60), 'is t in minutes?'),
+    ('one angle row of 1.5 rad', 'tspike.csv', table(theta=np.where(np.arange(N) == 300, 1.5, 0.01)),
+     'column theta jumps from 0.01 to 1.5 rad at row 301'),
+    ('one angle row of 50 rad', 'tspike50.csv', table(theta=np.where(np.arange(N) == 300, 50.0, 0.01)),
+     'column theta jumps from 0.01 to'),
     ('underscore in a number', 'under.csv', '\n'.join(ROWS[:9] + ['0.008,0,1_0.5'] + ROWS[10:]) + '\n',
      "row 10, column 'voltage': '1_0.5' is not a number"),
 ]
@@ -209,3 +213,28 @@ def test_a_balancing_loop_whose_angle_equation_is_blurred_is_read_as_written(tmp
     plant = PlantParams(**{k: c[k] for k in ('M', 'm', 'l', 'alpha', 'beta')})
     rec = load(d / 'data.csv', plant)
     assert rec.theta is not None and np.ptp(rec.x) < 0.2       # x read as x: centimetres of travel
+
+
+def test_a_fifo_is_refused_not_read_without_end(tmp_path, capsys):
+    import os
+    fifo = tmp_path / 'log.csv'
+    os.mkfifo(fifo)
+    for cmd in (['identify', str(fifo), '--out', str(tmp_path / 'out')], ['analyze', str(fifo), '--no-plots']):
+        assert main(cmd) == 2
+        assert 'not a regular file' in capsys.readouterr().err
+
+
+def test_analyze_cuts_a_rig_log_at_its_gap_and_says_so(tmp_path, capsys):
+    """A balancing loop's log (independent simulator, 30 s) with 2 s missing after t = 15 s: no balanced
+    stretch spans the gap, and the gap is named."""
+    from independent import rigsim
+    d = rigsim.generate('loop_none')
+    t = d['t'] + np.where(d['t'] > 15.0, 2.0, 0.0)
+    path = tmp_path / 'log.csv'
+    np.savetxt(path, np.column_stack([t, d['x'], d['voltage'], d['theta']]), delimiter=',',
+               header='t,x,voltage,theta', comments='', fmt='%.10g')
+    assert main(['analyze', str(path), '--no-plots', '--json']) == 0
+    r = json.loads(capsys.readouterr().out)['logs'][0]
+    assert any('1 gap(s) in the log (longest 2' in n for n in r['notes']), r['notes']
+    spans = [(s['start'], s['end']) for s in r['segments']]
+    assert len(spans) == 2 and spans[0][1] <= 15.0 + 1e-9 and spans[1][0] >= 17.0, spans

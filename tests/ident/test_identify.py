@@ -11,6 +11,7 @@ from ipfric_core.cli import main
 from ipfric_core.design.estimation import load_table5, load_table6
 from ipfric_core.ident.equation_error import base_fit, identify_steady
 from ipfric_core.ident.excitation import cart_alone_run
+from ipfric_core.ident.model import read_declared
 from ipfric_core.ident.redesign import close_the_loop
 from ipfric_core.physics.params import ConfigError, FrictionParams, PlantParams
 from ipfric_core.physics.rig import PlantTruth
@@ -150,6 +151,13 @@ def test_cli_csv_report_and_export(tmp_path, clean, capsys):
     assert sc.friction.mu_c == pytest.approx(TRACK.mu_c, rel=0.05)
     assert main(['identify', str(csv), '--effects', 'friction_wobble', '--out', str(tmp_path)]) == 2
     assert 'friction_wobble' in capsys.readouterr().err
+
+
+@pytest.mark.parametrize('name', ['default.yaml', 'fig7_old_gain_exponential.yaml'])
+def test_a_shipped_scenario_declares_the_plant_and_the_friction(name):
+    """--plant takes a scenario whose sections are written /**/sim_node: (any namespace), as shipped."""
+    scn = load_scenario(ROOT / 'config' / name)
+    assert read_declared(ROOT / 'config' / name, 'coulomb') == (scn.plant, scn.friction)
 
 
 def test_free_constant_is_refitted_only_when_asked(tmp_path, clean, capsys):

@@ -101,6 +101,7 @@ def test_command_writes_summary_runs_and_histogram(tmp_path, capsys):
 
 @pytest.mark.parametrize('args, field', [
     (['--runs', '0', '--spread', 'mu_s=0.3'], '--runs'),
+    (['--runs', '1000000000000', '--spread', 'mu_s=0.3'], 'allowed 1 .. 1,000,000'),   # before any draw
     (['--spread', 'mu_s=0.3', '--duration', '-1'], '--duration'),
     (['--spread', 'friction=0.3'], '--spread'),
     ([], '--spread'),

@@ -95,6 +95,31 @@ def test_unreachable_scheduler_is_a_clear_error(tmp_path, capsys):
 
 
 @pytest.mark.timeout(60)
+@pytest.mark.parametrize('says, words', [(None, 'within 1 s'), (b'SSH-2.0-OpenSSH_9.6\r\n', 'is no Dask scheduler')])
+def test_a_port_that_is_no_scheduler_is_a_clear_error(says, words):
+    """A service that accepts the connection and says nothing, or something else than Dask's handshake:
+    refused within the timeout, no Client made (none left to fail at exit)."""
+    import threading
+    with socket.socket() as srv:
+        srv.bind(('127.0.0.1', 0))
+        srv.listen()
+        held = []
+
+        def accept():
+            conn, _ = srv.accept()
+            held.append(conn)
+            if says:
+                conn.sendall(says)
+        threading.Thread(target=accept, daemon=True).start()
+        t0 = time.monotonic()
+        with pytest.raises(SchedulerError, match=words):
+            make_executor(f'tcp://127.0.0.1:{srv.getsockname()[1]}', timeout=1.0)
+        assert time.monotonic() - t0 < 5.0
+        for conn in held:
+            conn.close()
+
+
+@pytest.mark.timeout(60)
 @pytest.mark.parametrize('address', ['notahost:xx', 'tcp://', 'http://10.0.0.5:8786', 'tcp://h:99999', 'tcp://a b'])
 def test_a_malformed_scheduler_address_is_refused_before_any_work(address, tmp_path, capsys):
     for argv in (['montecarlo', '--spread', 'mu_s=0.3', '--runs', '2'],

@@ -199,13 +199,19 @@ class Regime:
         return asdict(self)
 
 
-def balanced_segments(t, theta, max_angle: float = math.radians(20.0), min_duration: float = 2.0) -> list:
+def balanced_segments(t, theta, max_angle: float = math.radians(20.0), min_duration: float = 2.0,
+                      breaks=()) -> list:
     """(first, last + 1) sample indices of the stretches with |theta| < ``max_angle`` [rad]
-    (from upright) lasting at least ``min_duration`` [s]."""
+    (from upright) lasting at least ``min_duration`` [s], none across one of ``breaks`` (indices of
+    the samples that follow a gap in the record)."""
     ok = np.abs(np.asarray(theta, float)) < max_angle
     edges = np.diff(np.concatenate([[0], ok.astype(np.int8), [0]]))
     starts, ends = np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0]
-    return [(int(a), int(b)) for a, b in zip(starts, ends) if t[b - 1] - t[a] >= min_duration]
+    out = []
+    for a, b in zip(starts, ends):
+        cuts = [int(a)] + [int(k) for k in breaks if a < k < b] + [int(b)]
+        out += [(p, q) for p, q in zip(cuts, cuts[1:]) if t[q - 1] - t[p] >= min_duration]
+    return out
 
 
 def regimes(t, x, theta, resolution=(4.54e-5, 1.534e-3), window: float = 8.0, step: float = 1.0) -> list:

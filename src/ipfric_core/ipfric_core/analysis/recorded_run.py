@@ -26,7 +26,7 @@ from ..physics.params import ConfigError
 from .bagread import RunData, read_run
 from .oscillation import balanced_segments, classify, regime_of, regimes
 from .plots import overlay_figure, run_figure
-from .records import load, smallest_step
+from .records import gap_starts, load, smallest_step
 
 __all__ = ['LOOP_PARAMETERS', 'parameter_changes', 'parameter_regimes', 'analyze_run', 'overlay_runs', 'analyze_log']
 
@@ -171,7 +171,7 @@ def analyze_log(path: str | Path, columns: dict | None = None, angle_zero: str =
                 plot_dir: str | Path | None = None) -> dict:
     """A rig's log (the formats of ``identify``: CSV t, x, voltage, theta; ``columns``
     maps names to headers) cut into balanced stretches (|theta| < ``max_angle`` [rad] for
-    at least ``min_duration`` [s]), each into regimes: class, time span, cart and angle
+    at least ``min_duration`` [s], none across a gap in the log), each into regimes: class, time span, cart and angle
     peak-to-peak, period by zero crossings and by spectrum, sticking."""
     rec = load(path, None, columns, angle_zero=angle_zero)
     if rec.theta is None:
@@ -181,12 +181,13 @@ def analyze_log(path: str | Path, columns: dict | None = None, angle_zero: str =
     zero = 'hanging' if any('hanging' in n for n in rec.notes) else 'upright'
     resolution = (smallest_step(rec.x, 0.0), smallest_step(theta, 0.0))
     segments = []
-    for a, b in balanced_segments(rec.t, theta, max_angle, min_duration):
+    for a, b in balanced_segments(rec.t, theta, max_angle, min_duration, gap_starts(rec.t)):
         parts = regimes(rec.t[a:b], rec.x[a:b], theta[a:b], resolution)
         segments.append({'start': float(rec.t[a]), 'end': float(rec.t[b - 1]), 'class': parts[-1].cls,
                          'regimes': [r.to_dict() for r in parts]})
     out = {'path': str(path), 'samples': int(len(rec.t)), 'duration_s': float(rec.t[-1] - rec.t[0]),
-           'sample_period_s': rec.dt, 'angle_zero': zero, 'count_size': list(resolution), 'segments': segments}
+           'sample_period_s': rec.dt, 'angle_zero': zero, 'count_size': list(resolution), 'segments': segments,
+           'notes': list(rec.notes)}
     if plot_dir is not None:
         d = Path(plot_dir)
         d.mkdir(parents=True, exist_ok=True)

@@ -28,14 +28,15 @@ from scipy.signal import butter, sosfiltfilt
 
 from ..physics.params import ConfigError, PlantParams
 
-__all__ = ['Record', 'smallest_step', 'smooth_rate', 'angle_equation', 'upright_angle', 'frozen_tail', 'ANGLE_ZEROS',
-           'is_log', 'parse_columns', 'load', 'trajectory_record']
+__all__ = ['Record', 'smallest_step', 'smooth_rate', 'angle_equation', 'upright_angle', 'frozen_tail', 'gap_starts',
+           'ANGLE_ZEROS', 'is_log', 'parse_columns', 'load', 'trajectory_record']
 
 MIN_SAMPLES = 200
 MIN_PART_COUNTS = 100   # encoder counts an estimation or validation part must move at least
 MAX_ROWS = 2_000_000    # a longer CSV is refused (33 min at 1 kHz; identification would take hours)
 MAX_VOLTAGE = 100.0     # |u| beyond this is not a drive command [V] (lab drives give 5-48 V)
 MAX_CART_SPEED = 10.0   # a position step faster than this between two rows is a corrupt row [m/s]
+MAX_ANGLE_RATE = 100.0  # an angle step faster than this (unwrapped) is a corrupt row [rad/s] (16 turns a second)
 MIN_PERIOD_S = 1e-4     # shortest median sample period taken as seconds (10 kHz) [s]
 MAX_PERIOD_S = 0.1      # longest [s]
 OVERRUN_JUMP = 1.75     # a stamp step this many times the median period starts an overrun
@@ -292,6 +293,13 @@ def upright_angle(t, x, theta, l: float, g: float, zero: str = 'auto') -> tuple[
     return out, notes
 
 
+def gap_starts(t: np.ndarray) -> np.ndarray:
+    """Indices of the samples that follow a gap in a log: a stamp step of GAP_PERIODS median periods
+    and at least GAP_S [s]."""
+    d = np.diff(t)
+    return np.flatnonzero(d > max(GAP_PERIODS * float(np.median(d)), GAP_S)) + 1
+
+
 def check_record(rec: Record, angle_zero: str = 'auto') -> Record:
     """Refuse what cannot be measured data (NaN, time going back, absurd ranges, too few
     samples); take what rigs write (uneven stamps, overruns, wrapped or hanging angles)."""
@@ -347,14 +355,20 @@ def check_record(rec: Record, angle_zero: str = 'auto') -> Record:
             raise ConfigError(f'{rec.name}: column theta reaches {np.max(np.abs(theta)):g}; expected radians '
                               f'from upright or from hanging (degrees?)')
         _, length, gravity = rec.pendulum if rec.pendulum is not None else (0.0, 1.0, 9.81)
+        rate = np.abs(np.diff(np.unwrap(theta))) / d
+        if np.any(rate > MAX_ANGLE_RATE):
+            i = int(np.flatnonzero(rate > MAX_ANGLE_RATE)[0])
+            raise ConfigError(f'{rec.name}: column theta jumps from {theta[i]:g} to {theta[i + 1]:g} rad at row '
+                              f'{i + 2} (t = {rec.t[i + 1]:g} s), {rate[i]:.3g} rad/s unwrapped; allowed at most '
+                              f'{MAX_ANGLE_RATE:g} rad/s between rows (a corrupt row?); clean or cut the data')
         theta, found = upright_angle(rec.t, rec.x, theta, length, gravity, angle_zero)
         notes += found
     valid = overruns(rec.t, [rec.x] + ([theta] if theta is not None else []))
-    gaps = np.flatnonzero(d > max(GAP_PERIODS * period, GAP_S)) + 1
+    gaps = gap_starts(rec.t)
     if len(gaps):
         valid[gaps] = False
         notes.append(f'{len(gaps)} gap(s) in the log (longest {float(np.max(d[gaps - 1])):.3g} s, first at '
-                     f't = {rec.t[gaps[0] - 1]:.3g} s): no window spans one')
+                     f't = {rec.t[gaps[0] - 1]:.3g} s): nothing is compared or analysed across one')
     if not valid.all():
         notes.append(f'{int((~valid).sum())} stale readings after {int(np.sum(np.diff(valid.astype(int)) == -1))} '
                      f'sample overruns (stamp jump, encoders frozen): not compared')
@@ -541,6 +555,9 @@ def load(path: str | Path, plant: PlantParams | None, columns: dict | None = Non
     ``plant`` None: a bag's stored scenario, Table 1 for a CSV. ``angle_zero``: where a CSV's
     angle is measured from (:data:`ANGLE_ZEROS`)."""
     p = Path(path)
+    if p.exists() and not (p.is_file() or p.is_dir()):
+        raise ConfigError(f'{p}: not a regular file (a FIFO, socket or device would be read without end); give '
+                          f'a .csv, an EMPS .mat, a run directory or a bag')
     if p.suffix.lower() == '.csv' or p.name.lower().endswith('.csv.gz'):
         return load_csv(p, plant or PlantParams(), columns, angle_zero, cart_alone)
     if p.suffix.lower() == '.mat':

@@ -79,6 +79,8 @@ def print_log_analysis(r: dict) -> None:
     """Readable summary of one :func:`~ipfric_core.analysis.recorded_run.analyze_log` result: a row per regime."""
     print(f'{r["path"]}: {r["samples"]} samples, {r["duration_s"]:.2f} s every {r["sample_period_s"] * 1e3:.3g} ms, '
           f'angle from {r["angle_zero"]}; {len(r["segments"])} balanced stretch(es)')
+    for note in r['notes']:
+        print(f'  note: {note}')
     for i, seg in enumerate(r['segments'], 1):
         print(f'  stretch {i}: {seg["start"]:.2f}-{seg["end"]:.2f} s, ends {seg["class"]}')
         for g in seg['regimes']:

@@ -24,7 +24,7 @@ HELP = ('distribution of the hunting (cart and angle peak-to-peak, period, class
 def add_arguments(mc) -> None:
     mc.add_argument('--config', default=str(DEFAULT_SCENARIO),
                     help='scenario whose parameters are drawn (default %(default)s)')
-    mc.add_argument('--runs', type=int, default=1000, help='number of runs (default %(default)s)')
+    mc.add_argument('--runs', type=int, default=1000, help='number of runs, 1 .. 1,000,000 (default %(default)s)')
     mc.add_argument('--duration', type=float, default=20.0,
                     help='simulated seconds per run (default %(default)s; at least 10 samples, at most 1e6 s)')
     mc.add_argument('--spread', metavar='NAME=S,...',

@@ -49,6 +49,23 @@ def scheduler_address(address: str) -> tuple[str, int]:
     return m.group('host').strip('[]'), port
 
 
+#: the largest first message [bytes] a Dask scheduler's handshake may announce
+MAX_GREETING = 1 << 20
+
+
+def _greeting(sock: socket.socket) -> int:
+    """The size [bytes] a TCP peer's first message announces, as Dask's framing has it (8 bytes, the
+    length of the frames that follow): a scheduler sends its handshake as soon as a client connects.
+    0 when the peer closes first; socket.timeout (an OSError) when it says nothing."""
+    head = b''
+    while len(head) < 8:
+        chunk = sock.recv(8 - len(head))
+        if not chunk:
+            return 0
+        head += chunk
+    return int.from_bytes(head, 'little')
+
+
 def make_executor(scheduler: str | None = None, workers: int | None = None,
                   timeout: float = CONNECT_TIMEOUT_S) -> Executor:
     """An executor for independent runs.
@@ -62,11 +79,16 @@ def make_executor(scheduler: str | None = None, workers: int | None = None,
         return ProcessPoolExecutor(max_workers=workers or os.cpu_count())
     host, port = scheduler_address(scheduler)
     try:   # a plain connection first: a Client that never connects takes 10 s more to close
-        socket.create_connection((host, port), timeout=timeout).close()
+        with socket.create_connection((host, port), timeout=timeout) as sock:
+            greeting = _greeting(sock) if not scheduler.strip().lower().startswith('tls://') else None
     except OSError as exc:
         raise SchedulerError(f'--scheduler {scheduler}: no Dask scheduler answers at {host}:{port} within '
                              f'{timeout:g} s ({exc.strerror or type(exc).__name__}); start one with `dask scheduler` '
                              f'and give its address, e.g. tcp://HOST:8786') from None
+    if greeting is not None and not 0 < greeting <= MAX_GREETING:
+        raise SchedulerError(f'--scheduler {scheduler}: {host}:{port} accepts connections but is no Dask scheduler '
+                             f'(its first message is no Dask handshake); start one with `dask scheduler` and give '
+                             f'its address, e.g. tcp://HOST:8786')
     from distributed import Client
     try:
         client = Client(scheduler, timeout=timeout, set_as_default=False)

@@ -166,6 +166,7 @@ def write_results(rows: list[dict], info: dict, out: str | Path, title: str) -> 
 
 #: the largest seed (run i draws with the seed (seed, i)); seeds are 0 .. MAX_SEED
 MAX_SEED = 2**32 - 1
+MAX_RUNS = 1_000_000     # --runs at most (1000 runs of 20 s take about 10 s on two cores: this is hours)
 #: the fewest samples a run may take (--duration at least this many sample periods)
 MIN_RUN_SAMPLES = 10
 
@@ -207,8 +208,8 @@ def montecarlo_study(draw: Callable[[int], tuple[dict, Scenario]], info: dict, r
                      progress: Callable[[int, int], None] | None = None) -> dict:
     """:func:`run_montecarlo` of ``runs`` draws, written by :func:`write_results` into ``out`` (``info``
     heads the summary); returns the summary."""
-    if runs < 1:
-        raise ConfigError(f'--runs: {runs} must be >= 1')
+    if not 1 <= runs <= MAX_RUNS:
+        raise ConfigError(f'--runs: {runs} is out of range; allowed 1 .. {MAX_RUNS:,}')
     if not (math.isfinite(duration) and duration > 0):
         raise ConfigError(f'--duration: {duration!r} must be > 0 s')
     if workers is not None and workers < 1:
