@@ -101,3 +101,6 @@ def test_ctrl_c_stops_the_run_and_keeps_a_readable_bag(tmp_path):
     assert not bag.truncated and bag.end_reason == 'ABORT'
     assert 'stopped by SIGINT' in bag.events[-1][2]
     assert len(bag.t) == res['samples'] > 100
+    shown = subprocess.run([sys.executable, '-m', 'ipfric_core.cli', 'analyze', str(out), '--no-plots'],
+                           capture_output=True, text=True, cwd=ROOT)
+    assert 'end: ABORT (stopped by SIGINT' in shown.stdout, shown.stdout     # analyze says why the run ended

@@ -100,10 +100,16 @@ class RunData:
 
     @property
     def end_reason(self) -> str | None:
-        for _, code, _ in reversed(self.events):
+        return self.end_event[0]
+
+    @property
+    def end_event(self) -> tuple[str | None, str]:
+        """(code, why) of the run's terminal event: why without the counts the simulator appends
+        ('stopped by SIGINT', 'duration 20 s reached'); (None, '') without one."""
+        for _, code, detail in reversed(self.events):
             if code in TERMINAL_EVENTS:
-                return code
-        return None
+                return code, detail.split('; samples ')[0]
+        return None, ''
 
 
 def mcap_file(path: str | Path) -> Path:

@@ -97,7 +97,8 @@ def analyze_run(path: str | Path, plot_dir: str | Path | None = None, window: fl
     changes = parameter_changes(run)
     spans = parameter_regimes(run, changes, _resolution(run), fallen)
     out = {'path': str(path), 'namespace': run.namespace, 'samples': int(len(run.t)),
-           'duration_s': float(run.t[-1] - run.t[0]), 'end_reason': run.end_reason, 'truncated': run.truncated,
+           'duration_s': float(run.t[-1] - run.t[0]), 'end_reason': run.end_reason, 'end_detail': run.end_event[1],
+           'truncated': run.truncated,
            'truncation_detail': run.truncation_detail, 'damage': run.damage, 'incomplete': run.incomplete,
            'counts': run.counts, 'gain': run.gain, 'parameter_changes': changes, 'parameter_regimes': spans,
            **{('class' if k == 'cls' else k): v for k, v in o.to_dict().items()}, **loop_timing(path)}

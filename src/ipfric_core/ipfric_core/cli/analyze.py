@@ -49,7 +49,8 @@ def print_run_analysis(r: dict) -> None:
     if r.get('class') is None:
         return
     tt = r['transition_time']
-    print(f'  {r["samples"]} samples, {r["duration_s"]:.2f} s, end: {r["end_reason"]}; '
+    why = f' ({r["end_detail"]})' if r['end_reason'] not in (None, 'END') and r['end_detail'] else ''
+    print(f'  {r["samples"]} samples, {r["duration_s"]:.2f} s, end: {r["end_reason"]}{why}; '
           + ('still converging' if tt is None else f'final regime from t = {tt:.3f} s'))
     print(f'  p2p: cart {r["x_p2p"] * 100:.3f} cm, angle {math.degrees(r["theta_p2p"]):.4f} deg; '
           f'cart at rest {100 * r["stick_fraction"]:.0f} % of the window')
