@@ -100,3 +100,10 @@ def test_a_domain_in_use_is_refused_before_start(tmp_path, capsys):
 def test_an_exponent_without_a_dot_is_a_number_as_for_ros(tmp_path):
     (tmp_path / 's.yaml').write_text(replaced('theta0: 0.02', 'theta0: 2e-2'))
     assert load_scenario(tmp_path / 's.yaml').sim.theta0 == 0.02
+
+
+def test_a_fifo_as_the_scenario_is_refused_as_not_a_file(tmp_path, capsys):
+    import os
+    os.mkfifo(tmp_path / 's.yaml')
+    assert main([a.replace('{dir}', str(tmp_path)) for a in RUN]) == 2
+    assert 's.yaml: not a regular file (a FIFO, device or socket)' in capsys.readouterr().err

@@ -406,6 +406,8 @@ def scenario_path(name: str | Path) -> Path:
     p = Path(name)
     if p.is_file():
         return p
+    if p.exists() and not p.is_dir():
+        raise ConfigError(f'{p}: not a regular file (a FIFO, device or socket); allowed: a YAML file')
     dirs = [REPO_ROOT / 'config'] + [Path(prefix) / 'share' / 'ipfric_bringup' / 'config'
                                      for prefix in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep) if prefix]
     if p.name == str(name):
