@@ -36,7 +36,7 @@ MIN_PART_COUNTS = 100   # encoder counts an estimation or validation part must m
 MAX_ROWS = 2_000_000    # a longer CSV is refused (33 min at 1 kHz; identification would take hours)
 MAX_VOLTAGE = 100.0     # |u| beyond this is not a drive command [V] (lab drives give 5-48 V)
 MAX_CART_SPEED = 10.0   # a position step faster than this between two rows is a corrupt row [m/s]
-MAX_ANGLE_RATE = 100.0  # an angle step faster than this (unwrapped) is a corrupt row [rad/s] (16 turns a second)
+MAX_ANGLE_RATE = 100.0  # a row whose angle leaves and comes back faster than this (unwrapped) is corrupt [rad/s]
 MIN_PERIOD_S = 1e-4     # shortest median sample period taken as seconds (10 kHz) [s]
 MAX_PERIOD_S = 0.1      # longest [s]
 OVERRUN_JUMP = 1.75     # a stamp step this many times the median period starts an overrun
@@ -355,12 +355,15 @@ def check_record(rec: Record, angle_zero: str = 'auto') -> Record:
             raise ConfigError(f'{rec.name}: column theta reaches {np.max(np.abs(theta)):g}; expected radians '
                               f'from upright or from hanging (degrees?)')
         _, length, gravity = rec.pendulum if rec.pendulum is not None else (0.0, 1.0, 9.81)
-        rate = np.abs(np.diff(np.unwrap(theta))) / d
-        if np.any(rate > MAX_ANGLE_RATE):
-            i = int(np.flatnonzero(rate > MAX_ANGLE_RATE)[0])
+        rate = np.diff(np.unwrap(theta)) / d
+        spikes = np.flatnonzero((np.abs(rate[:-1]) > MAX_ANGLE_RATE) & (np.abs(rate[1:]) > MAX_ANGLE_RATE)
+                                & (rate[:-1] * rate[1:] < 0))
+        if len(spikes):
+            i = int(spikes[0])
             raise ConfigError(f'{rec.name}: column theta jumps from {theta[i]:g} to {theta[i + 1]:g} rad at row '
-                              f'{i + 2} (t = {rec.t[i + 1]:g} s), {rate[i]:.3g} rad/s unwrapped; allowed at most '
-                              f'{MAX_ANGLE_RATE:g} rad/s between rows (a corrupt row?); clean or cut the data')
+                              f'{i + 2} (t = {rec.t[i + 1]:g} s) and back, {abs(rate[i]):.3g} rad/s unwrapped; '
+                              f'allowed at most {MAX_ANGLE_RATE:g} rad/s between rows (a corrupt row?); clean or '
+                              f'cut the data')
         theta, found = upright_angle(rec.t, rec.x, theta, length, gravity, angle_zero)
         notes += found
     valid = overruns(rec.t, [rec.x] + ([theta] if theta is not None else []))
