@@ -238,3 +238,12 @@ def test_analyze_cuts_a_rig_log_at_its_gap_and_says_so(tmp_path, capsys):
     assert any('1 gap(s) in the log (longest 2' in n for n in r['notes']), r['notes']
     spans = [(s['start'], s['end']) for s in r['segments']]
     assert len(spans) == 2 and spans[0][1] <= 15.0 + 1e-9 and spans[1][0] >= 17.0, spans
+
+
+def test_an_angle_whose_equation_does_not_show_is_read_as_written_and_said_so(tmp_path):
+    """An angle unrelated to the cart's motion (its equation shows neither term): read as radians from
+    upright, with a note that its zero, unit and column could not be checked."""
+    walk = np.cumsum(np.random.default_rng(3).normal(0.0, 2e-4, N))
+    (tmp_path / 'flat.csv').write_text(table(theta=np.round(walk / 1.5e-3) * 1.5e-3 + 0.01))
+    notes = ' '.join(load(tmp_path / 'flat.csv', None).notes)
+    assert 'does not show where its angle is zero' in notes and 'nor can degrees or x and theta swapped' in notes

@@ -268,7 +268,8 @@ def upright_angle(t, x, theta, l: float, g: float, zero: str = 'auto') -> tuple[
         notes.append('the pendulum\'s motion does not show where its angle is zero (the gravity term of its '
                      f'equation is {grav:.3g} 1/s^2 with t = {t_grav:.2g}, {0.75 * g / l:.3g} expected): read as '
                      + ('measured from hanging, as the angle stays more than 90 deg from its zero' if far else
-                        'measured from upright') + '; --angle-zero says otherwise')
+                        'measured from upright') + ', in radians as written (nor can degrees or x and theta '
+                     'swapped be told from it); --angle-zero says otherwise')
     else:
         offset = np.pi if zero == 'hanging' else 0.0
     flip = -1.0 if offset else 1.0
