@@ -106,4 +106,4 @@ def test_a_fifo_as_the_scenario_is_refused_as_not_a_file(tmp_path, capsys):
     import os
     os.mkfifo(tmp_path / 's.yaml')
     assert main([a.replace('{dir}', str(tmp_path)) for a in RUN]) == 2
-    assert 's.yaml: not a regular file (a FIFO, device or socket)' in capsys.readouterr().err
+    assert 's.yaml: not a regular file (a FIFO, device or directory); allowed: a YAML file' in capsys.readouterr().err

@@ -214,9 +214,9 @@ def read_declared(path, law: str) -> tuple[PlantParams | None, FrictionParams]:
     friction = next(f for f in paper.values() if f.model == law)
     if path is None:
         return None, friction
-    from ..run.scenario import NODE_NAMES, load_scenario
+    from ..run.scenario import NODE_NAMES, load_scenario, section_node
     data = load_yaml(path)
-    if isinstance(data, dict) and any(str(k).rstrip('/').rsplit('/', 1)[-1] in NODE_NAMES for k in data):
+    if isinstance(data, dict) and any(section_node(k) in NODE_NAMES for k in data):
         scn = load_scenario(path)       # sections sim_node:, /**/sim_node:, /rig1/sim_node: ...
         return scn.plant, scn.friction
     check_keys(str(path), data, {'plant', 'friction', 'design'}, {'plant'})

@@ -68,9 +68,8 @@ from ..physics.plant import CartPendulum
 from ..physics.rig import PLANT_TRUTH_FIELDS, PlantTruth, Rig
 
 __all__ = ['DEFAULT_SCENARIO', 'TIME_MODES', 'NODE_NAMES', 'SECTION_KEYS', 'SIM_FIELDS', 'CONTROLLER_FIELDS',
-           'Scenario', 'check_namespace', 'key_matches',
-           'nest', 'node_sections', 'scenario_from_ros_params', 'scenario_from_sections', 'load_scenario',
-           'scenario_path']
+           'Scenario', 'check_namespace', 'key_matches', 'nest', 'section_node', 'node_sections',
+           'scenario_from_ros_params', 'scenario_from_sections', 'load_scenario', 'scenario_path']
 
 #: the scenario ``./ipfric run`` and the other commands take when none is given
 DEFAULT_SCENARIO = REPO_ROOT / 'config' / 'default.yaml'
@@ -360,6 +359,12 @@ def _one_type_arrays(path: str, value: Any) -> None:
                           f'file): write every number with a decimal point, e.g. {fixed!r}')
 
 
+def section_node(key) -> str:
+    """The node name a parameter file's section key ends in: 'sim_node' of sim_node:, /**/sim_node:,
+    /rig1/sim_node:."""
+    return str(key).rstrip('/').rsplit('/', 1)[-1]
+
+
 def node_sections(data: Mapping, namespace: str = '/', path: str | Path = '<scenario>') -> dict:
     """The ``ros__parameters`` each node of ``NODE_NAMES`` in ``namespace`` gets from a parameter
     file's ``data``, by rcl's rules: every section whose key matches the node, merged in file order;
@@ -367,7 +372,7 @@ def node_sections(data: Mapping, namespace: str = '/', path: str | Path = '<scen
     ns = check_namespace(namespace)
     found: dict = {}
     for key, section in data.items():
-        last = str(key).rstrip('/').rsplit('/', 1)[-1]
+        last = section_node(key)
         if last not in NODE_NAMES and last not in ('*', '**'):
             raise ConfigError(f'{path}: unknown section {key!r}; allowed: sections for '
                               f'{", ".join(NODE_NAMES)} (e.g. /**/sim_node, which matches the node in any '
@@ -404,10 +409,8 @@ def scenario_path(name: str | Path) -> Path:
     of the checkout's ``config/`` and those installed in ``share/ipfric_bringup/config`` of every
     prefix of ``AMENT_PREFIX_PATH``."""
     p = Path(name)
-    if p.is_file():
+    if p.exists() and not p.is_dir():      # a FIFO or device too: load_yaml refuses it by name
         return p
-    if p.exists() and not p.is_dir():
-        raise ConfigError(f'{p}: not a regular file (a FIFO, device or socket); allowed: a YAML file')
     dirs = [REPO_ROOT / 'config'] + [Path(prefix) / 'share' / 'ipfric_bringup' / 'config'
                                      for prefix in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep) if prefix]
     if p.name == str(name):
