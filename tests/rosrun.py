@@ -89,20 +89,20 @@ def started(log: Path, proc, timeout: float = 120.0) -> None:
 
 
 @contextmanager
-def run_beside_peer(config, out: Path, name: str, peer_first: bool = False, **kwargs):
-    """A :class:`Run` of ``config`` and, once its simulator started (``peer_first``: before its nodes
-    start, so that the peer has discovered them by sample 0), a :class:`Peer` ``name`` in the run's
-    domain; both ended however the block ends. Yields (run, peer)."""
+def run_beside_peer(config, out: Path, name: str, setup=None, **kwargs):
+    """A :class:`Run` of ``config`` and, before its nodes start (so that the peer is discovered by
+    sample 0), a :class:`Peer` ``name`` in the run's domain, given to ``setup`` (its publishers,
+    subscriptions and clients) then; both ended however the block ends. Yields (run, peer, what
+    ``setup`` returned)."""
     r = Run(config, out, timeout=300, **kwargs)
     peer = None
     try:
-        if peer_first:
-            r.prepare()
-            peer = Peer(name, domain=r.domain)
+        r.prepare()
+        peer = Peer(name, domain=r.domain)
+        ready = setup(peer) if setup else None
         r.start()
         started(r.logs['sim_node'], r.procs['sim_node'])
-        peer = peer or Peer(name, domain=r.domain)
-        yield r, peer
+        yield r, peer, ready
     finally:
         if peer is not None:
             peer.close()

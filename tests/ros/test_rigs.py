@@ -63,11 +63,13 @@ def test_a_run_time_delay_change_is_in_the_bag_and_in_analyze(tmp_path):
 
     from ipfric_ros import topics
     cfg = scenario_file(tmp_path, 'fig9_new_gain_exponential.yaml', sim={'duration': 12.0})
-    with run_beside_peer(cfg, tmp_path / 'run', 'lab_user', peer_first=True) as (r, peer):
-        seen = [0]
+    seen = [0]
+
+    def setup(peer):
         peer.node.create_subscription(JointState, topics.JOINT_STATES,      # the latest sample, not a backlog
                                       lambda m: seen.__setitem__(0, m.header.stamp.sec), topics.data_qos(1))
-        client = peer.node.create_client(SetParameters, '/controller_node/set_parameters')
+        return peer.node.create_client(SetParameters, '/controller_node/set_parameters')
+    with run_beside_peer(cfg, tmp_path / 'run', 'lab_user', setup=setup) as (r, peer, client):
         peer.spin_until(client.service_is_ready, 60, 'the parameter service')
 
         def set_delay(value):

@@ -1,7 +1,7 @@
 """A rig keeps its own loop whatever a stranger publishes on its topics.
 
 A second process (another node in the run's domain and namespace) publishes on the rig's
-topics from the simulator's start to its end: idle, a flood of bad commands, commands for the
+topics from before the nodes start to the run's end: idle, a flood of bad commands, commands for the
 very samples the controller answers, bogus joint states. The controller obeys the simulator's
 measurements only and the simulator its controller's commands only (by publisher), so the
 pendulum stays balanced: the lockstep trajectory is the offline closed loop's, bit for bit,
@@ -84,8 +84,7 @@ def bogus_joint_states(peer, topics):
 def test_a_stranger_leaves_the_rig_balanced_and_is_reported(tmp_path, stranger):
     from ipfric_ros import topics
     cfg = scenario_file(tmp_path, 'default.yaml', sim={'duration': DURATION})
-    with run_beside_peer(cfg, tmp_path / 'run', 'rogue') as (r, peer):
-        tick = stranger(peer, topics)
+    with run_beside_peer(cfg, tmp_path / 'run', 'rogue', setup=lambda peer: stranger(peer, topics)) as (r, _, tick):
         while r.procs['sim_node'].poll() is None:
             tick()
         res = r.wait()

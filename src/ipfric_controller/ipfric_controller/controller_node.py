@@ -105,6 +105,7 @@ class ControllerNode(Node):
         self.ready = False
         self.published = 0
         self.rejected = 0
+        self.named: set[str] = set()    # strangers whose refused measurements were logged by name
         self.last_index = None
         self._names = None
         self._index = (0, 1)
@@ -175,10 +176,14 @@ class ControllerNode(Node):
         """One measurement taken from the subscription; whether a command went out."""
         if not self.rig.accepts(gid):
             self.rejected += 1
-            self.get_logger().error(
-                f'joint_states from {self.rig.strangers.get(gid, "?")}, not {self.rig.expected}: refused '
-                f'({sum(self.rig.refused.values())} so far); the rig is controlled on its own measurements',
-                throttle_duration_sec=1.0)
+            who = self.rig.strangers.get(gid, '?')
+            text = (f'joint_states from {who}, not {self.rig.expected}: refused ({sum(self.rig.refused.values())} '
+                    f'so far); the rig is controlled on its own measurements')
+            if who != '?' and who not in self.named:     # each stranger named once, as soon as the graph knows it
+                self.named.add(who)
+                self.get_logger().error(text)
+            else:
+                self.get_logger().error(text, throttle_duration_sec=1.0)
             return False
         if not self.ready:
             return False

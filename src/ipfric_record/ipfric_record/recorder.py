@@ -6,9 +6,9 @@ and writes them unchanged, under their resolved names (``/joint_states``; ``/rig
 when the recorder runs in namespace ``/rig1``), into a rosbag2 directory
 (:class:`ipfric_record.bagwriter.BagWriter`): ``<output>/metadata.yaml`` and
 ``<output>/<name>_0.mcap`` with a schema for every channel, message indexes and a Statistics
-record, as rosbag2 itself writes them. ``/parameter_events`` is recorded too, the events of
-the rig's own nodes only (those in the recorder's namespace): a ``ros2 param set`` of the
-controller's delay or gain during the run is in the bag with its simulated-time stamp. Each
+record, as rosbag2 itself writes them. ``/parameter_events`` is recorded too, the changes of
+the rig's own nodes only (those in the recorder's namespace; not their start-up declarations):
+a ``ros2 param set`` of the controller's delay or gain during the run is in the bag with its simulated-time stamp. Each
 message is stamped with the recorder's wall clock when it is taken (as ``ros2 bag record``
 does), never decreasing; the header stamps carry the simulated time.
 
@@ -132,9 +132,11 @@ class Recorder(Node):
                 self.end_event = code
 
     def _on_parameter_event(self, msg: ParameterEvent) -> None:
-        """A parameter event of a node of this rig (its namespace) into the bag."""
+        """A parameter event of a node of this rig (its namespace) that changes or deletes a parameter into
+        the bag; not the declarations at a node's start, which reach the recorder or not depending on which
+        process is up first (the bag would differ from run to run)."""
         namespace = msg.node.rsplit('/', 1)[0] or '/'
-        if namespace == self.get_namespace():
+        if namespace == self.get_namespace() and (msg.changed_parameters or msg.deleted_parameters):
             self.writer.write(topics.PARAMETER_EVENTS, self._log_time(), serialize_message(msg))
 
     def drain(self) -> int:
