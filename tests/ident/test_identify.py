@@ -91,8 +91,10 @@ def test_emps_beats_the_published_reference_models(data_dir, tmp_path):
     """EMPS (a real prismatic drive, force input): the ladder adds the direction dependence; the final
     model runs free over the held-out pulses file closer than both reference models of the benchmark
     (9.66 mm symmetric with offset, 8.63 mm asymmetric: their published values run free from the same
-    20 readings by an integrator of its own, 10 sub-steps per sample), and its force balance is within
-    the published asymmetric model's 3.11 %; nothing ends on a bound."""
+    20 readings by an integrator of its own, 10 sub-steps per sample), and its force balance is below
+    2.3 %, under the published asymmetric model's 3.11 %: its friction rises with speed (a static level
+    below the Coulomb level, the exponential law's curve rising over about 1.5 cm/s); nothing ends on a
+    bound."""
     d = data_dir / 'emps'
     assert main(['identify', str(d / 'DATA_EMPS.mat'), '--test', str(d / 'DATA_EMPS_PULSES.mat'),
                  '--out', str(tmp_path), '--no-plots']) == 0
@@ -100,11 +102,12 @@ def test_emps_beats_the_published_reference_models(data_dir, tmp_path):
     assert r['effects_added'] == ['asymmetry'], r['rounds']
     assert r['test']['rmse_mm'] < 8.63 and r['test']['diverged_samples'] == 0
     first, last = r['force_error'][0], r['force_error'][-1]
-    assert last['validation']['relative_percent'] < 3.11
+    assert last['estimation']['relative_percent'] < 2.3 and last['validation']['relative_percent'] < 2.3
     assert last['validation']['rms'] < 0.5 * first['validation']['rms']
     final = {p['name']: p for p in r['ladder'][-1]['params']}
     assert 94 < final['M']['value'] < 96 and final['Fc']['value'] > 15
-    assert not [p['name'] for p in final.values() if p['at_bound'] and p['name'] != 'Fs_excess']
+    assert final['Fs_excess']['value'] < -3 * final['Fs_excess']['std'] and 0.005 < final['v_s']['value'] < 0.05
+    assert not [p['name'] for p in final.values() if p['at_bound']]
     assert r['ladder'][-1]['validation']['x_rms_counts'] < r['ladder'][0]['validation']['x_rms_counts']
 
 

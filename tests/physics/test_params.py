@@ -46,7 +46,8 @@ def test_friction_model_needs_its_fields():
 
 
 def test_coulomb_above_static_is_refused():
-    with pytest.raises(ConfigError, match='friction.mu_c: 0.09 exceeds mu_s'):
+    with pytest.raises(ConfigError, match='friction.mu_c: 0.09 exceeds mu_s = 0.08; allowed 0 <= mu_c <= mu_s for '
+                                          'the coulomb law'):
         FrictionParams.from_dict({'model': 'coulomb', 'eps': 3, 'mu_s': 0.08, 'mu_c': 0.09})
 
 

@@ -40,6 +40,25 @@ def test_sticks_breaks_away_and_resticks():
     assert t[-1] == pytest.approx(2.6)
 
 
+def test_a_friction_rising_with_speed_breaks_away_at_its_static_level():
+    """mu_s below mu_c (the exponential law's curve rising with speed): the cart holds below mu_s F_N,
+    breaks away above it and slides slowly, where the level is near mu_s F_N, but a push between
+    the two levels cannot drive it fast: the level it meets at speed is mu_c F_N."""
+    rising = FrictionParams('exponential', eps=3.0, mu_s=0.03, mu_c=0.0861, v_s=0.02, gamma=2.0)
+    fn = PLANT.normal_force
+    sim = Simulator(CartPendulum(PLANT, rising), [0.0, math.pi, 0.0, 0.0])
+    held = 0.9 * 0.03 * fn / PLANT.alpha             # 90 % of the static level
+    between = 0.5 * (0.03 + 0.0861) * fn / PLANT.alpha
+    t, x, v, stuck = run(sim, [(0.5, held), (2.0, between)])
+    assert np.all(stuck[:500]) and np.all(x[:500] == 0.0)
+    assert not stuck[520] and np.all(v[520:] > 0)
+    # sliding, the force balances the level between mu_s and mu_c F_N: a speed of order v_s, not the
+    # several m/s a Coulomb level of mu_s F_N would give over 2 s
+    assert 0.5 * 0.02 < v[-1] < 3 * 0.02
+    assert FrictionParams.from_dict({'model': 'exponential', 'eps': 3, 'mu_s': 0.03, 'mu_c': 0.0861, 'v_s': 0.02,
+                                     'gamma': 2}) == rising
+
+
 def test_pendulum_reaction_breaks_the_cart_loose():
     """A swinging pendulum alone pushes the cart past static friction (held force includes it)."""
     sim = Simulator(CartPendulum(PLANT, EXP), [0.0, math.pi + 0.8, 0.0, 4.0])

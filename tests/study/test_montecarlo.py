@@ -2,6 +2,7 @@
 import csv
 import json
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -29,6 +30,9 @@ def test_draws_depend_on_seed_and_run_only(fig7):
     assert scn.controller == fig7.controller and scn.sim == fig7.sim
     draws = [spread_draw(fig7, {'mu_s': 1.0, 'mu_c': 1.0}, 0, i)[1].friction for i in range(200)]
     assert all(0.0 <= f.mu_c <= f.mu_s for f in draws)                  # clipped to the range, mu_c <= mu_s
+    rising = replace(fig7, friction=replace(fig7.friction, mu_s=0.03, mu_c=0.05))   # a level rising with speed
+    draws = [spread_draw(rising, {'mu_s': 1.0, 'mu_c': 1.0}, 0, i)[1].friction for i in range(200)]
+    assert all(f.mu_c >= f.mu_s for f in draws) and sum(f.mu_c > f.mu_s for f in draws) > 100   # its order kept
     keys = {tuple(spread_draw(fig7, {'mu_s': 1.0}, 0, i)[0]) for i in range(200)}
     assert keys == {('mu_s', 'mu_c')}            # a spread of mu_s alone: every run's row holds the mu_c it ran
     uniform = [spread_draw(fig7, {'eps': 0.3}, 0, i, 'uniform')[0]['eps'] for i in range(200)]

@@ -29,7 +29,8 @@ def add_arguments(mc) -> None:
                     help='simulated seconds per run (default %(default)s; at least 10 samples, at most 1e6 s)')
     mc.add_argument('--spread', metavar='NAME=S,...',
                     help='relative 1-sigma spreads of plant or friction coefficients, e.g. mu_s=0.3,mu_c=0.3,eps=0.3 '
-                         '(30 %%); each value = nominal * (1 + S z), clipped to its range, mu_c <= mu_s')
+                         '(30 %%); each value = nominal * (1 + S z), clipped to its range, mu_c and mu_s in the '
+                         'nominal\'s order')
     mc.add_argument('--distribution', choices=DISTRIBUTIONS, default='normal',
                     help='--spread: z ~ N(0, 1) (S is one sigma) or z ~ U(-1, 1) (S is the half width) '
                          '(default %(default)s)')

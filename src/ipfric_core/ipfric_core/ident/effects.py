@@ -22,8 +22,9 @@ from ..physics.params import FRICTION_FIELDS, PLANT_FIELDS, FrictionParams
 from ..physics.plant import undeclared_forces
 from ..physics.rig import PLANT_TRUTH_FIELDS, drive_means, inputs_through
 
-__all__ = ['ParamSpec', 'PARAMS', 'Effect', 'BASE_PARAMS', 'EFFECTS', 'BASE_MODELS', 'effective_input', 'plateaus',
-           'dwell_profile', 'fitted_friction_vector', 'static_levels', 'position_force', 'resisting_force']
+__all__ = ['ParamSpec', 'PARAMS', 'Effect', 'BASE_PARAMS', 'EFFECTS', 'BASE_MODELS', 'lower_bound', 'static_level',
+           'effective_input', 'plateaus', 'dwell_profile', 'fitted_friction_vector', 'static_levels', 'position_force',
+           'resisting_force']
 
 
 @dataclass(frozen=True)
@@ -59,7 +60,8 @@ def _schema(table: dict, name: str, typical: float) -> ParamSpec:
 PARAMS: dict[str, ParamSpec] = {p.name: p for p in (
     *(_schema(PLANT_FIELDS, k, v) for k, v in (('M', 0.5), ('m', 0.1), ('l', 0.1), ('alpha', 1.0), ('beta', 5.0))),
     ParamSpec('Fc', 'N', 0.0, 50.0, 0.3, 'Coulomb level mu_c F_N, eq. (6)'),
-    ParamSpec('Fs_excess', 'N', 0.0, 50.0, 0.3, 'static minus Coulomb level (mu_s - mu_c) F_N, eq. (5)'),
+    ParamSpec('Fs_excess', 'N', -50.0, 50.0, 0.3, 'static minus Coulomb level (mu_s - mu_c) F_N, eq. (5); below 0 '
+              'the Stribeck curve rises from the static to the Coulomb level (a friction that grows with speed)'),
     *(_schema(FRICTION_FIELDS, k, v) for k, v in (('eps', 2.0), ('v_s', 0.05), ('sigma0', 1e4), ('sigma1', 1.0))),
     *(_schema(PLANT_TRUTH_FIELDS, k, v) for k, v in (
         ('cogging_sin_N', 0.1), ('cogging_cos_N', 0.1), ('cogging_period_m', 0.01), ('offset_N', 0.1),
@@ -141,6 +143,20 @@ BASE_MODELS = {
 }
 
 
+def lower_bound(name: str, active) -> float:
+    """The lower bound of parameter ``name`` with the friction parts ``active`` (keys of :data:`EFFECTS`):
+    :data:`PARAMS`'s, but 0 for Fs_excess without the stribeck effect: a static level below the Coulomb
+    level needs the Stribeck curve to rise from one to the other (eq. 8); the coulomb law holds at least
+    its sliding level."""
+    return 0.0 if name == 'Fs_excess' and 'stribeck' not in active else PARAMS[name].lo
+
+
+def static_level(fc: float, excess: float) -> float:
+    """Fs = Fc + Fs_excess [N], the static level of eq. (5): at least 0 (a static level fitted to 0 or
+    below is refuted: :func:`ipfric_core.ident.ladder.bound_params`)."""
+    return max(fc + excess, 0.0)
+
+
 def effective_input(t: np.ndarray, u: np.ndarray, p: dict, active) -> np.ndarray:
     """u_eff: the input after delay and lag (their mean over each sample interval), deadzone and saturation
     (same unit as u), the rig's law."""
@@ -190,7 +206,7 @@ def fitted_friction_vector(p: dict, active) -> tuple:
     """The identified friction as the parameter vector of :mod:`ipfric_core.physics.friction`
     (:func:`~ipfric_core.physics.friction.friction_vector` of the law's FrictionParams).
 
-    Levels are in N (F_N = 1): mu_c = Fc, mu_s = Fc + Fs_excess, gamma = 2. Without the
+    Levels are in N (F_N = 1): mu_c = Fc, mu_s = Fc + Fs_excess (:func:`static_level`), gamma = 2. Without the
     stribeck effect the dynamic law's level stays at Fc. Fc is floored at 1e-9 N, where the
     laws divide by the level.
     """
@@ -201,11 +217,12 @@ def fitted_friction_vector(p: dict, active) -> tuple:
     fc = max(p['Fc'], 1e-9)
     stribeck = 'stribeck' in active
     if 'presliding' in active:
-        law = FrictionParams(model='dynamic', eps=p['eps'], mu_c=fc, mu_s=fc + p['Fs_excess'] if stribeck else fc,
+        law = FrictionParams(model='dynamic', eps=p['eps'], mu_c=fc,
+                             mu_s=static_level(fc, p['Fs_excess']) if stribeck else fc,
                              v_s=p['v_s'] if stribeck else 1.0, sigma0=p['sigma0'], sigma1=p['sigma1'], **asym)
     else:
         law = FrictionParams(model='exponential' if stribeck else 'coulomb', eps=p['eps'], mu_c=fc,
-                             mu_s=fc + p['Fs_excess'], v_s=p['v_s'] if stribeck else 1.0, **asym)
+                             mu_s=static_level(fc, p['Fs_excess']), v_s=p['v_s'] if stribeck else 1.0, **asym)
     return friction_vector(law, 1.0)
 
 

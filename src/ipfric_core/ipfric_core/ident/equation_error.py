@@ -206,7 +206,7 @@ def fit(pr: Prepared, active, start: dict) -> Fit:
     names = [s.name for s in specs]
     umax = float(np.max(np.abs(pr.u_full)))
     # input effects may not switch the input off: a deadzone below half, a limit above a third of max |u|
-    lo = np.array([0.3 * umax if s.name == 'saturation_V' else s.lo for s in specs])
+    lo = np.array([0.3 * umax if s.name == 'saturation_V' else fx.lower_bound(s.name, active) for s in specs])
     hi = np.array([0.5 * umax if s.name == 'deadzone_V' else s.hi for s in specs])
     x0 = np.clip(np.array([start[nm] for nm in names], float), lo + 1e-12 * (hi - lo), hi - 1e-12 * (hi - lo))
 

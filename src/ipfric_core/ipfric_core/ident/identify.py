@@ -19,7 +19,7 @@ from ..analysis.records import Record, load
 from ..design.estimation import load_table5, load_table6
 from ..physics.params import ConfigError, FrictionParams, PlantParams
 from ..run.scenario import DEFAULT_SCENARIO, load_scenario
-from .effects import EFFECTS, PARAMS
+from .effects import EFFECTS, PARAMS, static_level
 from .equation_error import base_fit, force_error, identify_steady, structure_fit
 from .held_out import INIT_SAMPLES, free_run
 from .ladder import Problem, Step, run_ladder, verdict
@@ -70,7 +70,8 @@ def force_input_model(rec: Record, law: str) -> Model:
     plant = PlantParams(M=f['M'], alpha=rec.gain, beta=rec.back_emf)
     fn = plant.M * plant.g
     fc = f.get('Fc', 0.0)
-    friction = FrictionParams(model=law, eps=f['eps'], mu_c=fc / fn, mu_s=(fc + f.get('Fs_excess', 0.0)) / fn,
+    friction = FrictionParams(model=law, eps=f['eps'], mu_c=fc / fn,
+                              mu_s=static_level(fc, f.get('Fs_excess', 0.0)) / fn,
                               **{k: f[k] for k in ('v_s', 'sigma0', 'sigma1') if k in f})
     return declared(plant, friction, False)
 

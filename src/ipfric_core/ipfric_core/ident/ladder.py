@@ -525,10 +525,16 @@ def law_starts(declared: Model) -> dict:
 BRISTLE_Z = (1e-4, 1e-5)
 
 
+def peak_level(model: Model) -> float:
+    """The highest level of the model's Stribeck curve [N]: the static level, or the Coulomb level where the
+    curve rises with speed (Fs_excess < 0)."""
+    return model['Fc'] + max(model['Fs_excess'], 0.0)
+
+
 def bristle_starts(model: Model) -> list[dict]:
     """Start values of the dynamic law's bristles: a stiffness that holds the static level within each
     presliding displacement of BRISTLE_Z, damped critically on the cart's mass (sigma1 = 2 sqrt(sigma0 M))."""
-    fs = model['Fc'] + model['Fs_excess']
+    fs = peak_level(model)
     p = model.param('sigma0')
     out = []
     for z in BRISTLE_Z:
@@ -552,7 +558,7 @@ def hypotheses(pe: Problem, current: Model, declared: Model, allowed=None) -> li
         if other != current.law:
             m = current.with_law(other, law_starts(declared))
             if other == 'dynamic':      # bristles stiffer than a tenth of a count of presliding are not seen
-                m = m.with_bounds('sigma0', 0.0, 10 * (m['Fc'] + m['Fs_excess']) / rec.x_resolution)
+                m = m.with_bounds('sigma0', 0.0, 10 * peak_level(m) / rec.x_resolution)
             out.append(Hypothesis(f'law {other}', 'law', m, LAW_PARAMS[other], LAW_PARAMS[other],
                                   bristle_starts(m) if other == 'dynamic' else [{}]))
     for name in PLANT_CORRECTIONS:
@@ -633,16 +639,25 @@ def errors_of(pe: Problem, h: Hypothesis, model: Model, prior: Model) -> dict:
                      profile=set(SIZE.get(h.effect or '', ())) | set(h.own))[1]
 
 
-#: parameters whose lower bound is the simpler law itself, not a limit of physics: static friction no
-#: higher than the Coulomb level is Coulomb friction without stiction (the data saw no sticking)
+#: parameters whose lower bound is the simpler law itself, not a limit of physics: in the coulomb law,
+#: static friction no higher than the Coulomb level is Coulomb friction without stiction (the data saw no
+#: sticking); the laws with a Stribeck curve take a static level below it (a friction that rises with speed)
 NESTED_AT_LOWER = ('Fs_excess',)
+
+
+def no_static_level(model: Model, p) -> bool:
+    """True when ``p`` is Fs_excess and puts the static level Fc + Fs_excess at 0 or below (no static
+    friction at all: :func:`~ipfric_core.ident.effects.static_level`)."""
+    return p.name == 'Fs_excess' and model['Fc'] + p.value <= 1e-3 * PARAMS[p.name].typical
 
 
 def bound_params(model: Model) -> list:
     """The fitted parameters of ``model`` that end on a bound of their range; but for
-    :data:`NESTED_AT_LOWER` at their lower one."""
+    :data:`NESTED_AT_LOWER` at their lower one; Fs_excess also where :func:`no_static_level`."""
     def refutes(p) -> bool:
         tol = 1e-3 * PARAMS[p.name].typical
+        if no_static_level(model, p):
+            return True
         return p.at_bound(tol) and not (p.name in NESTED_AT_LOWER and p.value - p.lo <= tol)
     return [p for p in model.free if refutes(p)]
 
@@ -650,7 +665,11 @@ def bound_params(model: Model) -> list:
 def on_bounds(model: Model) -> list[str]:
     """Why a fitted parameter of ``model`` refutes it: it ends on a bound of its range (a bound reached
     means the law or the effect is refuted there; :func:`bound_params`)."""
-    return [f'{p.name} = {p.value:.4g} {p.unit} ends on its bound [{p.lo:g}, {p.hi:g}]' for p in bound_params(model)]
+    def bound(p) -> str:
+        if no_static_level(model, p):
+            return f'-Fc = {-model["Fc"]:.4g} N: no static friction'
+        return f'[{p.lo:g}, {p.hi:g}]'
+    return [f'{p.name} = {p.value:.4g} {p.unit} ends on its bound {bound(p)}' for p in bound_params(model)]
 
 
 def untold(model: Model, std: dict) -> list[str]:

@@ -18,7 +18,7 @@ from ..physics.friction import friction_vector
 from ..physics.params import ConfigError, FrictionParams, PlantParams
 from ..physics.plant import plant_vector
 from ..physics.rig import PlantTruth
-from .effects import EFFECTS, PARAMS
+from .effects import BASE_MODELS, EFFECTS, PARAMS, lower_bound, static_level
 
 __all__ = ['Param', 'PLANT_KNOWN', 'LAW_PARAMS', 'FRICTION_FITTED', 'LADDER_EFFECTS', 'TRUTH_PARAMS', 'param',
            'ModelVectors', 'Model', 'declared', 'read_declared', 'load_declared']
@@ -58,10 +58,11 @@ LADDER_EFFECTS = ('deadzone', 'saturation', 'delay', 'lag', 'cogging', 'asymmetr
 TRUTH_PARAMS = tuple(n for e in LADDER_EFFECTS for n in EFFECTS[e].params)
 
 
-def param(name: str, value: float, free: bool) -> Param:
-    """Parameter ``name`` of :data:`~ipfric_core.ident.effects.PARAMS` at ``value``."""
+def param(name: str, value: float, free: bool, law: str = 'viscous') -> Param:
+    """Parameter ``name`` of :data:`~ipfric_core.ident.effects.PARAMS` at ``value``, within its bounds under
+    the friction law ``law`` (:func:`~ipfric_core.ident.effects.lower_bound`)."""
     s = PARAMS[name]
-    return Param(name, float(value), s.unit, s.lo, s.hi, free, s.doc)
+    return Param(name, float(value), s.unit, lower_bound(name, BASE_MODELS[law]), s.hi, free, s.doc)
 
 
 @dataclass(frozen=True)
@@ -141,7 +142,8 @@ class Model:
         this model's values where it has them, else at ``starts``; the plant and the effects kept."""
         own = set(LAW_PARAMS[law])
         kept = [p for p in self.params if p.name not in FRICTION_FITTED]
-        new = [param(n, self.get(n, starts[n]) if any(p.name == n for p in self.params) else starts[n], True)
+        new = [param(n, max(self.get(n, starts[n]) if any(p.name == n for p in self.params) else starts[n],
+                            lower_bound(n, BASE_MODELS[law])), True, law)
                for n in LAW_PARAMS[law] if n in own]
         plant = [p for p in kept if p.name in PLANT_KNOWN]
         rest = [p for p in kept if p.name not in PLANT_KNOWN]
@@ -160,7 +162,7 @@ class Model:
         bristle = self.law == 'dynamic'
         base = FrictionParams()
         return FrictionParams(model=self.law, eps=self['eps'], mu_c=fc / fn,
-                              mu_s=(fc + self.get('Fs_excess')) / fn, v_s=self.get('v_s', 0.105),
+                              mu_s=static_level(fc, self.get('Fs_excess')) / fn, v_s=self.get('v_s', 0.105),
                               gamma=self.gamma, sigma0=self['sigma0'] if bristle else base.sigma0,
                               sigma1=self['sigma1'] if bristle else base.sigma1)
 
@@ -195,7 +197,7 @@ def declared(plant: PlantParams, friction: FrictionParams, pendulum: bool) -> Mo
     params = [param(k, getattr(plant, k), False) for k in PLANT_KNOWN]
     values = {'Fc': friction.mu_c * fn, 'Fs_excess': (friction.mu_s - friction.mu_c) * fn,
               'eps': friction.eps, 'v_s': friction.v_s, 'sigma0': friction.sigma0, 'sigma1': friction.sigma1}
-    params += [param(k, values[k], False) for k in LAW_PARAMS[friction.model]]
+    params += [param(k, values[k], False, friction.model) for k in LAW_PARAMS[friction.model]]
     return Model(friction.model, tuple(params), (), friction.gamma, plant.g, fn, pendulum)
 
 

@@ -175,9 +175,10 @@ class FrictionParams:
         if smoothing == 'tanh' and model not in ('coulomb', 'exponential'):
             raise ConfigError(f'{path}.smoothing: tanh applies to the coulomb and exponential '
                               f'models, not {model!r}; use none')
-        if model != 'viscous' and values.get('mu_c', 0.0) > values.get('mu_s', 0.0):
-            raise ConfigError(f'{path}.mu_c: {values["mu_c"]:g} exceeds mu_s = {values["mu_s"]:g}; '
-                              f'allowed 0 <= mu_c <= mu_s')
+        if model == 'coulomb' and values.get('mu_c', 0.0) > values.get('mu_s', 0.0):
+            raise ConfigError(f'{path}.mu_c: {values["mu_c"]:g} exceeds mu_s = {values["mu_s"]:g}; allowed '
+                              f'0 <= mu_c <= mu_s for the coulomb law (a static level below the Coulomb level '
+                              f'needs the Stribeck curve of the exponential or dynamic law to rise to it)')
         return cls(model=model, smoothing=smoothing, **values)
 
     def to_dict(self) -> dict:

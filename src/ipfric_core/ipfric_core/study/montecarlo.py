@@ -81,7 +81,8 @@ def clip_to_range(value: float, spec: Field) -> float:
 def spread_draw(base: Scenario, spread: dict[str, float], seed: int, index: int,
                 distribution: str = 'normal') -> tuple[dict, Scenario]:
     """Run ``index``'s coefficients: each nominal value times 1 + s z (``DISTRIBUTIONS``), clipped to
-    its range, mu_c kept <= mu_s (eq. 8); (the drawn values, ``base`` with them in plant and friction)."""
+    its range, mu_c and mu_s kept in the nominal's order (a Stribeck level that falls with speed, or one
+    that rises: eq. 8); (the drawn values, ``base`` with them in plant and friction)."""
     rng = np.random.default_rng([seed, index])
     z = rng.standard_normal(len(spread)) if distribution == 'normal' else rng.uniform(-1.0, 1.0, len(spread))
     sections = {'plant': base.plant, 'friction': base.friction}
@@ -93,7 +94,7 @@ def spread_draw(base: Scenario, spread: dict[str, float], seed: int, index: int,
     for k, v in values.items():
         drawn[SPREAD_FIELDS[k][0]][k] = v
     plant, friction = replace(base.plant, **drawn['plant']), replace(base.friction, **drawn['friction'])
-    if friction.mu_c > friction.mu_s:
+    if (friction.mu_c > friction.mu_s) != (base.friction.mu_c > base.friction.mu_s):
         friction = replace(friction, mu_c=friction.mu_s)
     if 'mu_s' in spread or 'mu_c' in spread:      # the mu_c run (clipped or not): every row has the same keys
         values['mu_c'] = friction.mu_c
