@@ -268,7 +268,7 @@ def bench_identify(quick: bool) -> list[dict]:
     helped = subprocess.run(base + ['--help'], capture_output=True, text=True)
     out_dir = REPO_ROOT / 'runs' / 'bench-identify'
     cases = [('identify on EMPS (both files, full effect search)',
-              [str(EMPS / 'DATA_EMPS.mat'), '--validation', str(EMPS / 'DATA_EMPS_PULSES.mat'), '--base', 'coulomb']),
+              [str(EMPS / 'DATA_EMPS.mat'), '--test', str(EMPS / 'DATA_EMPS_PULSES.mat')]),
              ('identify on a 2-min 1 kHz closed-loop record (independent simulator, cogging)', None)]
     rows = []
     for name, args in cases:
@@ -283,7 +283,8 @@ def bench_identify(quick: bool) -> list[dict]:
             from tests.independent import rigsim
             args = [str(rigsim.write_case('loop_cogging', out_dir, duration=120.0))]
         t0 = time.perf_counter()
-        out = subprocess.run(base + args + ['--out', str(out_dir / 'report'), '--json', '--no-plots'],
+        out = subprocess.run(base + args + ['--out', str(out_dir / ('emps' if args[0].endswith('.mat') else 'loop')),
+                                            '--json', '--no-plots'],
                              capture_output=True, text=True, timeout=1800)
         wall = time.perf_counter() - t0
         if out.returncode != 0:

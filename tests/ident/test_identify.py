@@ -108,6 +108,8 @@ def test_emps_beats_the_published_reference_models(data_dir, tmp_path):
     assert 94 < final['M']['value'] < 96 and final['Fc']['value'] > 15
     assert final['Fs_excess']['value'] < -3 * final['Fs_excess']['std'] and 0.005 < final['v_s']['value'] < 0.05
     assert not [p['name'] for p in final.values() if p['at_bound']]
+    rises = 'the friction rises with speed: from a static level of 13.'
+    assert any(n.startswith(rises) for n in r['ladder'][-1]['notes'])
     assert r['ladder'][-1]['validation']['x_rms_counts'] < r['ladder'][0]['validation']['x_rms_counts']
 
 

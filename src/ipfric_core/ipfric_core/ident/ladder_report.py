@@ -148,6 +148,15 @@ def coverage_note(step: Step, at: dict) -> list[str]:
             f'friction at those speeds, not the Coulomb level beyond v_s nor the viscous slope apart']
 
 
+def curve_note(step: Step) -> list[str]:
+    """What a Stribeck curve that rises with speed (a static level below the Coulomb level) says."""
+    m = step.model
+    if m.law not in ('exponential', 'dynamic') or m['Fs_excess'] >= 0.0:
+        return []
+    return [f'the friction rises with speed: from a static level of {m["Fc"] + m["Fs_excess"]:.4g} N at rest to '
+            f'the Coulomb level {m["Fc"]:.4g} N beyond v_s = {m["v_s"]:.3g} m/s (eq. 8 with Fs below Fc)']
+
+
 def ladder_result(res: dict) -> dict:
     est, val = res['estimation'], res['validation']
     steps = res['steps']
@@ -163,7 +172,8 @@ def ladder_result(res: dict) -> dict:
                   'within the windows; estimation data fit, validation data judge',
         'ladder': [{'step': s.label, 'effects': list(s.model.effects), 'estimation': s.est, 'validation': s.val,
                     'params': param_table(s), 'correlations': correlations(s), 'covariance': covariance(s),
-                    'friction_at_speeds': friction_curve(s, at), 'notes': s.notes + coverage_note(s, at)}
+                    'friction_at_speeds': friction_curve(s, at),
+                    'notes': s.notes + coverage_note(s, at) + curve_note(s)}
                    for s in steps],
         'effects_added': list(steps[-1].model.effects),
         'constants_corrected': [n for n in PLANT_CORRECTIONS if steps[-1].model.param(n).free],

@@ -11,7 +11,9 @@ Models (``FrictionParams.model``):
 - ``dynamic``      F = -(sigma1 + eps) v - sigma0 z (1 - sigma1 |v| / g(v)),
                    z' = v - sigma0 |v| z / g(v)                           eqs. (10)-(11)
 
-with the Stribeck level g(v) = (mu_c + (mu_s - mu_c) exp(-(|v|/v_s)^gamma)) F_N.
+with the Stribeck level g(v) = (mu_c + (mu_s - mu_c) exp(-(|v|/v_s)^gamma)) F_N: falling with speed
+(mu_s > mu_c, the paper's), or rising from a static level below the Coulomb one (mu_s < mu_c, a
+contact whose friction grows with speed; the coulomb law needs mu_s >= mu_c).
 
 Direction dependence (``asymmetry`` a, ``asymmetry_viscous`` dF_v; both 0 in the paper):
 the level is (1 + a) g forward and (1 - a) g backward, static friction included, and the
