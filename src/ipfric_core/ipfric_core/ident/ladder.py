@@ -621,14 +621,12 @@ def joint(h: Hypothesis, model: Model) -> set:
 
 def full_fit(pe: Problem, h: Hypothesis, best: Model, prior: Model) -> Model:
     """The fit of the hypothesis's parameters with every parameter the model already fits (:func:`joint`),
-    from its short fit ``best``. A fit that puts a friction level it refits on a bound (the declared law
-    refitted, or refitted beside an effect or a plant correction) is done again with that level held
-    where the model had it: the data did not determine it (below the Stribeck velocity the Coulomb level
-    and the static level trade), and a bound is no answer. A law switch keeps its bounds: they refute it."""
+    from its short fit ``best``. A refit of the declared law that puts one of its levels on a bound is
+    done again with that level held at its declared value: the data did not determine it (below the
+    Stribeck velocity the Coulomb level and the curve's width trade), and a bound is no answer."""
     m = fit_model(pe, best, only=joint(h, best), prior=prior, errors=False)[0]
-    levels = set(h.own) if h.kind == 'friction' else set(h.free) - set(h.own) if h.kind != 'law' else set()
-    if levels:
-        held = {p.name: h.model[p.name] for p in bound_params(m) if p.name in levels}
+    if h.kind == 'friction':
+        held = {p.name: prior[p.name] for p in bound_params(m) if p.name in LAW_PARAMS[m.law]}
         if held:
             m = fit_model(pe, m.holding(held), only=joint(h, best) - set(held), prior=prior, errors=False)[0]
     return m
@@ -929,9 +927,9 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
         label = {'friction': 'refit', 'law': win.h.label, 'plant': win.h.label}.get(win.h.kind, f'+ {win.h.effect}')
         step_notes = correction_notes(declared, current, s, est.theta is None) if win.h.kind == 'plant' else []
         step_notes += refit_notes(declared, current) if win.h.kind in ('friction', 'law', 'plant') else []
-        step_notes += [f'{p.name} held at {p.value:.4g} {p.unit}: the fit put it on a bound, the data do not '
-                       'determine it' for p in current.params
-                       if p.name in LAW_PARAMS[current.law] and p.name in win.h.free and not p.free]
+        step_notes += [f'{p.name} held at its declared {p.value:.4g} {p.unit}: the refit put it on a bound, the data '
+                       'do not determine it' for p in current.params
+                       if win.h.kind == 'friction' and p.name in LAW_PARAMS[current.law] and not p.free]
         steps.append(Step(label, current, s, pe.summary(current), pv.summary(current), step_notes))
         rounds.append({'round': round_no, 'kept': win.h.label,
                        'runner_up': _alternative(runner, pv) if runner else None})
