@@ -50,7 +50,7 @@ import numpy as np
 from ..analysis.records import Record, smooth_rate
 from ..physics.params import ConfigError
 from . import lsq, shooting
-from .effects import EFFECTS, PARAMS
+from .effects import EFFECTS, PARAMS, static_level
 from .model import FRICTION_FITTED, LADDER_EFFECTS, LAW_PARAMS, Model
 
 __all__ = ['PLANT_CORRECTIONS', 'Problem', 'Step', 'run_ladder', 'verdict']
@@ -648,7 +648,7 @@ NESTED_AT_LOWER = ('Fs_excess',)
 def no_static_level(model: Model, p) -> bool:
     """True when ``p`` is Fs_excess and puts the static level Fc + Fs_excess at 0 or below (no static
     friction at all: :func:`~ipfric_core.ident.effects.static_level`)."""
-    return p.name == 'Fs_excess' and model['Fc'] + p.value <= 1e-3 * PARAMS[p.name].typical
+    return p.name == 'Fs_excess' and static_level(model['Fc'], p.value) <= 1e-3 * PARAMS[p.name].typical
 
 
 def bound_params(model: Model) -> list:

@@ -16,7 +16,7 @@ from ..analysis.plots import save_figure  # noqa: E402
 from ..analysis.records import smooth_rate  # noqa: E402
 from ..physics.friction import friction_force  # noqa: E402
 from . import shooting  # noqa: E402
-from .effects import PARAMS  # noqa: E402
+from .effects import BASE_MODELS, PARAMS, static_level  # noqa: E402
 from .ladder import PLANT_CORRECTIONS, Problem, Step  # noqa: E402
 
 __all__ = ['correlation_lines', 'write_ladder_report']
@@ -151,10 +151,10 @@ def coverage_note(step: Step, at: dict) -> list[str]:
 def curve_note(step: Step) -> list[str]:
     """What a Stribeck curve that rises with speed (a static level below the Coulomb level) says."""
     m = step.model
-    if m.law not in ('exponential', 'dynamic') or m['Fs_excess'] >= 0.0:
+    if 'stribeck' not in BASE_MODELS[m.law] or m['Fs_excess'] >= 0.0:
         return []
-    return [f'the friction rises with speed: from a static level of {m["Fc"] + m["Fs_excess"]:.4g} N at rest to '
-            f'the Coulomb level {m["Fc"]:.4g} N beyond v_s = {m["v_s"]:.3g} m/s (eq. 8 with Fs below Fc)']
+    return [f'the friction rises with speed: from a static level of {static_level(m["Fc"], m["Fs_excess"]):.4g} N '
+            f'at rest to the Coulomb level {m["Fc"]:.4g} N beyond v_s = {m["v_s"]:.3g} m/s (eq. 8 with Fs below Fc)']
 
 
 def ladder_result(res: dict) -> dict:
