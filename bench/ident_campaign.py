@@ -57,10 +57,18 @@ def library_names() -> set[str]:
 
 
 # ------------------------------------------------------------------------------------ answers
-def components(truth: dict) -> list[dict]:
-    """Every undeclared discrepancy of a case: effects and a wrong declared constant."""
-    out = [dict(name=k, library=bool(v['library']), counts=float(v['contribution_counts_rms']))
-           for k, v in truth['effects'].items()]
+def components(truth: dict, threshold: float = THRESHOLD) -> list[dict]:
+    """Every undeclared discrepancy of a case: effects and a wrong declared constant. A two-mass drive
+    whose play alone (truth ``play_contribution_counts_rms``: the drive against its motor side fixed to
+    the cart) stays below ``threshold`` is a cart heavier by the motor side's mass: ``M corrected``."""
+    out = []
+    for k, v in truth['effects'].items():
+        comp = dict(name=k, library=bool(v['library']), counts=float(v['contribution_counts_rms']))
+        play = v.get('play_contribution_counts_rms')
+        if k == 'drive_backlash' and play is not None and play < threshold <= comp['counts']:
+            comp.update(name='M corrected', detail=f'a drive play of {play:.2g} counts: the motor side '
+                        f'({v["motor_mass_kg"]:.3g} kg) moves with the cart')
+        out.append(comp)
     pe = truth.get('plant_error')
     if pe:
         known = pe['name'] in CORRECTED or pe['name'] in EQUIVALENT
@@ -71,7 +79,7 @@ def components(truth: dict) -> list[dict]:
 
 
 def expected_answer(truth: dict, threshold: float = THRESHOLD) -> dict:
-    comps = components(truth)
+    comps = components(truth, threshold)
     seen = [c for c in comps if not c.get('equivalent')]
     above = sorted(c['name'] for c in seen if c['library'] and c['counts'] >= threshold)
     outside = sorted(c['name'] for c in seen if not c['library'] and c['counts'] >= threshold)
@@ -243,7 +251,7 @@ def score_case(truth: dict, ident: dict, threshold: float = THRESHOLD, generatio
         case=truth['case'], index=truth['index'], experiment=truth['experiment'],
         theta_column=truth['theta_column'], sample_period_s=truth['sample_period_s'],
         duration_s=truth['duration_s'], timing=truth['timing']['kind'],
-        components=components(truth), expected=exp['label'], expected_detail=exp,
+        components=components(truth, threshold), expected=exp['label'], expected_detail=exp,
         predicted=pred['label'], added=pred['added'], verdict=pred['verdict'],
         outcome=outcome(exp, pred), validation_counts=ladder, oracle_counts=oracle_counts,
         wall_s=ident.get('wall_s'),

@@ -33,7 +33,8 @@ FIXED = {
     66: ('cart alone, zeros theta column, overruns, offset 0.24 N (130 counts)', 'offset'),
     131: ('closed loop, jitter, delay 5.4 ms (16 counts)', 'delay'),
     331: ('closed loop, angle encoder bias 12.6 counts', 'sensor_bias'),
-    42: ('cart alone, overruns, two-mass drive play (260 counts)', 'drive_backlash'),
+    42: ('cart alone, overruns, a two-mass drive (264 counts, of which its 0.21 mm play alone 3.8 counts)',
+         'drive_backlash'),
     32: ('cart alone, a spring towards the centre (outside the library, 117 counts)', 'not_explained'),
 }
 
@@ -166,6 +167,31 @@ def test_a_wrong_declared_constant_expects_its_correction_or_not_explained():
     assert scorer.expected_answer(pendulum, 2.0)['label'] == 'not_explained'   # no correction for m, l
     assert scorer.detection_limit([(1.0, False), (3.0, True), (5.0, True), (9.0, True)]) == 3.0
     assert scorer.detection_limit([(1.0, True), (3.0, False)]) is None
+
+
+def test_a_drive_whose_play_is_not_seen_expects_the_mass_of_its_motor_side():
+    def drive(total, play):
+        truth = _truth((('drive_backlash', total),))
+        truth['effects']['drive_backlash'].update(play_contribution_counts_rms=play, motor_mass_kg=0.12)
+        return truth
+    mass = {'effects_added': [], 'constants_corrected': ['M'], 'verdict': {'explained': True}}
+    play = {'effects_added': ['drive_backlash'], 'constants_corrected': [], 'verdict': {'explained': True}}
+    hidden = scorer.expected_answer(drive(260.0, 1.5), 2.0)
+    assert hidden['label'] == 'M corrected'           # the motor side moves with the cart: a heavier cart
+    assert scorer.outcome(hidden, scorer.predicted_answer(mass)) == 'correct'
+    seen = scorer.expected_answer(drive(260.0, 3.8), 2.0)
+    assert seen['label'] == 'drive_backlash'          # the play itself reaches the threshold
+    assert scorer.outcome(seen, scorer.predicted_answer(play)) == 'correct'
+    assert scorer.outcome(seen, scorer.predicted_answer(mass)) == 'wrong'
+
+
+@pytest.mark.parametrize('seed, index, play_max', [(2026, 42, 6.0)])
+def test_the_generator_parts_a_drive_into_its_play_and_its_mass(seed, index, play_max):
+    """Case 42 of seed 2026: a 0.21 mm play with a motor side of a quarter of the cart's mass; the
+    drive changes the motion by 264 counts, nearly all of it the motor side's mass."""
+    _, truth = campaign.make_case(seed, index, duration=20.0)
+    q = truth['effects']['drive_backlash']
+    assert 0.5 < q['play_contribution_counts_rms'] < play_max < 10 * play_max < q['contribution_counts_rms']
 
 
 # ------------------------------------------------------------------------------------------ slow

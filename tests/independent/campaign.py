@@ -96,7 +96,7 @@ from . import rigsim
 
 _jit = numba.njit(cache=False)
 
-VERSION = 1
+VERSION = 2
 TRACK = 0.40            # the cart must stay within +-TRACK [m] (true position)
 SOFT_LIMIT = 0.28       # an open-loop segment hands over to the position loop beyond this [m]
 FALLEN = 0.5236         # |theta| from upright beyond which a balancing run has failed [rad]
@@ -844,6 +844,17 @@ def contributions(spec, data):
         a, b, mx = rms(d)
         out[name] = dict(contribution_counts_rms=a, contribution_counts_rms_validation=b,
                          contribution_counts_max=mx, unit=unit)
+        if name == "drive_backlash":
+            # the play's own part: the same drive with its motor side fixed to the cart (no play, a
+            # rigid contact), i.e. a cart heavier by the motor side's mass
+            q = full[name]
+            rigid = dict(rig, M=rig["M"] + q["motor_mass_kg"])
+            p2, inp2 = _pvec(spec, others, rigid)
+            Y2 = Y.copy()
+            Y2[:, 4:6] = Y[:, 0:2]
+            d = (x_with - _replay(t, volt, Y2, ST, starts, p2, inp2, presc, hmax)) / rig["x_res"]
+            a, b, _ = rms(d)
+            out[name].update(play_contribution_counts_rms=a, play_contribution_counts_rms_validation=b)
     pe = spec.get("plant_error")
     if pe is not None:
         wrong = dict(rig, **{pe["name"]: pe["declared"]})

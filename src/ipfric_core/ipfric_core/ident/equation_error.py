@@ -200,9 +200,11 @@ class Fit:
     cost: float        # mean squared residual [N^2] over the used samples (+ pendulum block)
 
 
-def fit(pr: Prepared, active, start: dict) -> Fit:
-    """Bounded least squares of all parameters of ``active`` from ``start``."""
-    specs = param_specs(active)
+def fit(pr: Prepared, active, start: dict, held: dict | None = None) -> Fit:
+    """Bounded least squares of all parameters of ``active`` from ``start``, but those of ``held``: held at
+    their values there (a declared mass)."""
+    held = held or {}
+    specs = [s for s in param_specs(active) if s.name not in held]
     names = [s.name for s in specs]
     umax = float(np.max(np.abs(pr.u_full)))
     # input effects may not switch the input off: a deadzone below half, a limit above a third of max |u|
@@ -211,7 +213,7 @@ def fit(pr: Prepared, active, start: dict) -> Fit:
     x0 = np.clip(np.array([start[nm] for nm in names], float), lo + 1e-12 * (hi - lo), hi - 1e-12 * (hi - lo))
 
     def fun(theta):
-        return residual_vector(pr, dict(zip(names, theta)), active)
+        return residual_vector(pr, {**held, **dict(zip(names, theta))}, active)
     sol = least_squares(fun, x0, bounds=(lo, hi), x_scale='jac', max_nfev=200, method='trf')
     r = sol.fun
     n = pr.n_used + len(pr.b_idx) + (pr.inside.sum() if pr.has_theta else 0)
@@ -226,7 +228,7 @@ def fit(pr: Prepared, active, start: dict) -> Fit:
         std[np.linalg.norm(J, axis=0) == 0.0] = np.nan  # the data say nothing about it
     except np.linalg.LinAlgError:
         std = np.full(len(names), np.nan)
-    p = dict(zip(names, map(float, sol.x)))
+    p = {**held, **dict(zip(names, map(float, sol.x)))}
     return Fit(tuple(active), p, dict(zip(names, map(float, std))), float(r @ r) / n)
 
 
@@ -249,11 +251,11 @@ def starts(pr: Prepared, name: str, p: dict, active) -> list[dict]:
     return [{**p, **base, **o} for o in options]
 
 
-def best_fit(pr: Prepared, active, candidates: list[dict]) -> Fit:
+def best_fit(pr: Prepared, active, candidates: list[dict], held: dict | None = None) -> Fit:
     """Fit from the start with the lowest initial cost (and from the best two if several)."""
     costs = [float(np.mean(residual_vector(pr, c, active) ** 2)) for c in candidates]
     order = np.argsort(costs)[:2]
-    fits = [fit(pr, active, candidates[i]) for i in order]
+    fits = [fit(pr, active, candidates[i], held) for i in order]
     return min(fits, key=lambda f: f.cost)
 
 
@@ -266,18 +268,20 @@ def errors(pr: Prepared, p: dict, active) -> dict:
             'samples': int(b.used.sum())}
 
 
-def base_fit(rec: Record, law: str) -> Fit:
+def base_fit(rec: Record, law: str, mass: float | None = None, pr: Prepared | None = None) -> Fit:
     """The force balance of friction law ``law`` (a key of :data:`~ipfric_core.ident.effects.BASE_MODELS`)
-    fitted to ``rec``: the mass, the viscous slope and the law's levels; viscous first (linear in them:
-    the start of the rest), then each part of the law in turn from its starts (:func:`starts`)."""
+    fitted to ``rec``: the mass (held at ``mass`` [kg] when given: a declared plant), the viscous slope
+    and the law's levels; viscous first (linear in them: the start of the rest), then each part of the
+    law in turn from its starts (:func:`starts`). ``pr``: ``rec`` already prepared."""
     if law not in fx.BASE_MODELS:
         raise ConfigError(f'base model: {law!r} is not one of {", ".join(fx.BASE_MODELS)}')
-    pe = Prepared(rec)
+    pe = pr or Prepared(rec)
     active = fx.BASE_MODELS[law]
-    start = dict(fit(pe, (), {'M': 1.0, 'eps': 0.0}).params)
+    held = {} if mass is None else {'M': float(mass)}
+    start = dict(fit(pe, (), {'M': 1.0, 'eps': 0.0}, held).params)
     for k, e in enumerate(active):
-        start = best_fit(pe, active[:k + 1], starts(pe, e, start, active[:k])).params
-    return fit(pe, active, start)
+        start = best_fit(pe, active[:k + 1], starts(pe, e, start, active[:k]), held).params
+    return fit(pe, active, start, held)
 
 
 def parts(law: str, effects) -> tuple:
