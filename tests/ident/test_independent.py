@@ -115,6 +115,29 @@ def test_a_friction_rising_with_speed_is_found_in_independent_data(tmp_path):
     assert res['verdict']['explained'], res['verdict']
 
 
+@pytest.mark.parametrize('factor', [1.0, 0.75, 1.3])
+def test_force_balance_starts_the_mass_and_friction_from_a_wrong_declaration(data, factor):
+    """The refit's and the plant corrections' starts from the cart's force balance
+    (``ladder.balance_starts``) on the independent clean cart record, the paper's cart (its mass as
+    Table 1) declared ``factor`` times its mass with the paper's friction: the mass with the mass free
+    within 2 %, the friction with it within 10 % (its Coulomb level, the viscous slope); with the mass
+    held as declared, alpha read for the same M / alpha within 2 %."""
+    from ipfric_core.ident.ladder import balance_starts
+    from ipfric_core.physics.params import PlantParams
+    truth = rigsim.RIGS['quanser']
+    rec = load(data['cart_none'], None, cart_alone=True)
+    est, _ = rec.split(0.6)
+    declared = load_declared(None, 'exponential', False, PlantParams(M=factor * truth['M']))
+    st = balance_starts(est, declared)
+    assert st['M']['M'] == pytest.approx(truth['M'], rel=0.02)
+    fn = truth['M'] * truth['g']
+    assert st['M']['Fc'] == pytest.approx(truth['mu_c'] * fn, rel=0.1)
+    assert st['M']['eps'] == pytest.approx(truth['eps'], rel=0.1)
+    assert st['alpha']['alpha'] == pytest.approx(declared['alpha'] * factor, rel=0.02)
+    if factor == 1.0:
+        assert st['refit']['Fc'] == pytest.approx(truth['mu_c'] * fn, rel=0.1)
+
+
 @pytest.mark.slow
 def test_drive_play_found_sized_and_exported(data, tmp_path, capsys):
     """A play between the motor side of a two-mass drive and the cart (the encoder on the cart),
