@@ -106,8 +106,11 @@ def predicted_answer(result: dict | None) -> dict:
 
 #: effects that act alike and are told apart only by a small part: a friction level (1 + a) Fc forward and
 #: (1 - a) Fc backward is Fc plus a constant force -a Fc while the cart slides; only a (Fs - Fc) (the
-#: Stribeck part, the static levels) tells the direction dependence from an offset
-ALIKE = ({'asymmetry', 'offset'},)
+#: Stribeck part, the static levels) tells the direction dependence from an offset. A transport delay d
+#: and a first-order lag of the command (ipfric's ``lag``, which the generator never draws) with the same
+#: d: exp(-s d) and 1 / (1 + s d) part at the order (s d)^2 / 2, below 1e-3 for a delay of a sample or two
+#: at the cart's bandwidth
+ALIKE = ({'asymmetry', 'offset'}, {'delay', 'lag'})
 #: on the cart alone the data fix M / alpha only ((M / alpha) x'' = V - ((beta + eps) / alpha) x' - F / alpha):
 #: a wrong alpha answered with M corrected (the friction scaled with it) is the same model, and the reverse
 CART_ALIKE = ({'M corrected', 'alpha corrected'},)

@@ -139,6 +139,8 @@ def _truth(effects=(), plant_error=None):
     ((('cogging', 9.0), ('delay', 5.0)), ['cogging'], None, 'cogging+delay', 'partial'),
     ((('asymmetry', 9.0),), ['offset'], None, 'asymmetry', 'alike'),     # alike while the cart slides
     ((('asymmetry', 9.0),), ['cogging'], None, 'asymmetry', 'wrong'),
+    ((('delay', 9.0),), ['lag'], None, 'delay', 'alike'),               # a lag of the same size acts alike
+    ((), ['lag'], None, 'none', 'false_positive'),
 ])
 def test_scorer_rules(effects, added, verdict, expected, outcome):
     truth = _truth(effects)
