@@ -446,7 +446,7 @@ def effect_starts(pr: Problem, model: Model, name: str, prior: Model) -> list[di
     also name other parameters of ``model`` (``prior``: the declared model)."""
     rec = pr.rec
     if name == 'cogging':
-        return [{'cogging_period_m': p} for p in (0.002, 0.0035, 0.006, 0.01, 0.015, 0.02)]
+        return [{'cogging_period_m': p} for p in (0.002, 0.0035, 0.006, 0.01, 0.015, 0.02)] + ripple_starts(rec, model)
     if name == 'delay':
         return [{'input_delay_s': d} for d in sorted({0.003, 0.01, 0.02, round(response_lag(rec), 4) or 0.001})]
     if name == 'deadzone':
@@ -464,6 +464,50 @@ def effect_starts(pr: Problem, model: Model, name: str, prior: Model) -> list[di
     if name == 'lag':
         return [{'input_lag_s': tau} for tau in (0.003, 0.01, 0.03)]
     return [{}]
+
+
+#: the periods [m] :func:`ripple_starts` regresses the force balance's residual on
+RIPPLE_PERIODS = tuple(np.geomspace(0.0015, 0.03, 60))
+
+
+def ripple_starts(rec: Record, model: Model, keep: int = 2) -> list[dict]:
+    """Cogging starts from the cart's force balance (:mod:`~ipfric_core.ident.equation_error`) of
+    ``model``: its residual regressed on sin and cos(2 pi x / P) for each period of RIPPLE_PERIODS,
+    the ``keep`` periods (15 % apart at least) that explain most of it, each with its amplitudes (the
+    sign that lowers the balance's residual: the residual is minus the force the model lacks). From
+    amplitudes of 0 the period has no gradient, and a fit from the nearest fixed period may stay at a
+    small ripple of the wrong phase. Empty where the balance cannot be formed."""
+    from .equation_error import Prepared, balance, parts
+    try:
+        pr = Prepared(rec)
+        p = {q.name: q.value for q in model.params}
+        active = parts(model.law, tuple(e for e in model.effects if e != 'cogging'))
+        b = balance(pr, p, active)
+    except (ConfigError, KeyError, ValueError):
+        return []
+    r, x = b.r[b.used], b.x[b.used]
+    if len(r) < 50 or not np.any(r):
+        return []
+    fits = []
+    for period in RIPPLE_PERIODS:
+        if np.ptp(x) < 3 * period:
+            continue
+        basis = np.column_stack([np.sin(2 * np.pi * x / period), np.cos(2 * np.pi * x / period)])
+        c, *_ = np.linalg.lstsq(basis, r, rcond=None)
+        fits.append((float(np.sum((basis @ c) ** 2)), period, c))
+    out: list[dict] = []
+    for _, period, c in sorted(fits, key=lambda f: -f[0]):
+        if len(out) == keep:
+            break
+        if any(abs(period / o['cogging_period_m'] - 1) < 0.15 for o in out):
+            continue
+        signed = []
+        for sign in (-1.0, 1.0):
+            q = {'cogging_sin_N': sign * float(c[0]), 'cogging_cos_N': sign * float(c[1]), 'cogging_period_m': period}
+            res = balance(pr, {**p, **q}, active + ('cogging',)).r
+            signed.append((float(res @ res), q))
+        out.append(min(signed, key=lambda t: t[0])[1])
+    return out
 
 
 #: the lightest motor side of a drive with play the ladder fits [share of the cart's mass]
