@@ -60,7 +60,9 @@ def library_names() -> set[str]:
 def components(truth: dict, threshold: float = THRESHOLD) -> list[dict]:
     """Every undeclared discrepancy of a case: effects and a wrong declared constant. A two-mass drive
     whose play alone (truth ``play_contribution_counts_rms``: the drive against its motor side fixed to
-    the cart) stays below ``threshold`` is a cart heavier by the motor side's mass: ``M corrected``."""
+    the cart) stays below ``threshold`` is a cart heavier by the motor side's mass: ``M corrected``. A
+    deadzone counts by what it does beyond a Coulomb level higher by alpha dz (truth
+    ``beyond_friction_counts_rms``): the friction every identification refits takes that part over."""
     out = []
     for k, v in truth['effects'].items():
         comp = dict(name=k, library=bool(v['library']), counts=float(v['contribution_counts_rms']))
@@ -68,6 +70,10 @@ def components(truth: dict, threshold: float = THRESHOLD) -> list[dict]:
         if k == 'drive_backlash' and play is not None and play < threshold <= comp['counts']:
             comp.update(name='M corrected', detail=f'a drive play of {play:.2g} counts: the motor side '
                         f'({v["motor_mass_kg"]:.3g} kg) moves with the cart')
+        beyond = v.get('beyond_friction_counts_rms')
+        if k == 'deadzone' and beyond is not None:
+            comp.update(counts=float(beyond), detail=f'{comp["counts"]:.3g} counts, {beyond:.3g} of them beyond a '
+                        'Coulomb level higher by alpha dz')
         out.append(comp)
     pe = truth.get('plant_error')
     if pe:

@@ -187,6 +187,22 @@ def test_a_drive_whose_play_is_not_seen_expects_the_mass_of_its_motor_side():
     assert scorer.outcome(seen, scorer.predicted_answer(mass)) == 'wrong'
 
 
+def test_a_deadzone_counts_by_what_a_friction_level_cannot_take_over():
+    def dz(total, beyond):
+        truth = _truth((('deadzone', total),))
+        truth['effects']['deadzone']['beyond_friction_counts_rms'] = beyond
+        return truth
+    none = {'effects_added': [], 'constants_corrected': [], 'verdict': {'explained': True}}
+    named = {'effects_added': ['deadzone'], 'constants_corrected': [], 'verdict': {'explained': True}}
+    small = scorer.expected_answer(dz(8.0, 1.6), 2.0)
+    assert small['label'] == 'none'               # a Coulomb level higher by alpha dz does the rest
+    assert scorer.outcome(small, scorer.predicted_answer(none)) == 'correct'
+    assert scorer.outcome(small, scorer.predicted_answer(named)) == 'acceptable'
+    large = scorer.expected_answer(dz(747.0, 230.0), 2.0)
+    assert large['label'] == 'deadzone'
+    assert scorer.outcome(large, scorer.predicted_answer(none)) == 'missed'
+
+
 @pytest.mark.parametrize('seed, index, play_max', [(2026, 42, 6.0)])
 def test_the_generator_parts_a_drive_into_its_play_and_its_mass(seed, index, play_max):
     """Case 42 of seed 2026: a 0.21 mm play with a motor side of a quarter of the cart's mass; the

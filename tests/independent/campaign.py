@@ -42,6 +42,11 @@ Sensors: x and theta rounded to the encoder counts (theta in the encoder's own f
 hanging or upright); sample overruns repeat the previous readings; jittered stamps are the true
 sample instants.
 
+Parts of an effect that a declared parameter takes over: a drive's play alone
+(``play_contribution_counts_rms``: against its motor side fixed to the cart, a heavier cart) and a
+deadzone beyond the friction (``beyond_friction_counts_rms``: against a Coulomb and static level
+higher by alpha dz, what the deadzone is while the cart moves the way it is driven).
+
 Contribution of an effect (truth ``contribution_counts_rms``): the recorded command is replayed
 from the true state at the start of each 1 s window (multiple shooting), once with every drawn
 effect and once without this one; the RMS over all samples of the difference in cart position,
@@ -844,6 +849,15 @@ def contributions(spec, data):
         a, b, mx = rms(d)
         out[name] = dict(contribution_counts_rms=a, contribution_counts_rms_validation=b,
                          contribution_counts_max=mx, unit=unit)
+        if name == "deadzone":
+            # the part a friction level cannot take over: while the cart moves the way it is driven, a
+            # deadzone dz is a Coulomb (and static) level higher by alpha dz
+            shift = rig["alpha"] * full[name]["dz_V"]
+            level = dict(rig, Fc=rig["Fc"] + shift, Fs=rig["Fs"] + shift)
+            p2, inp2 = _pvec(spec, others, level)
+            d = (x_with - _replay(t, volt, Y, ST, starts, p2, inp2, presc, hmax)) / rig["x_res"]
+            a, b, _ = rms(d)
+            out[name].update(beyond_friction_counts_rms=a, beyond_friction_counts_rms_validation=b)
         if name == "drive_backlash":
             # the play's own part: the same drive with its motor side fixed to the cart (no play, a
             # rigid contact), i.e. a cart heavier by the motor side's mass
