@@ -11,6 +11,7 @@ drive play (a two-mass drive) also that --export writes it.
 import json
 import math
 
+import numpy as np
 import pytest
 from independent import rigsim
 
@@ -136,6 +137,14 @@ def test_force_balance_starts_the_mass_and_friction_from_a_wrong_declaration(dat
     assert st['alpha']['alpha'] == pytest.approx(declared['alpha'] * factor, rel=0.02)
     if factor == 1.0:
         assert st['refit']['Fc'] == pytest.approx(truth['mu_c'] * fn, rel=0.1)
+
+
+@pytest.mark.parametrize('mean, bias', [(-math.pi + 0.12, 0.12), (0.01, 0.01), (math.pi - 0.04, -0.04)])
+def test_the_angle_bias_starts_from_the_nearest_rest(mean, bias):
+    """A hanging pendulum's angle, read from upright, averages near +/-pi: the bias starts at its offset from
+    there (it started at the mean itself, -3 rad, and ended on its bound of 1 rad)."""
+    from ipfric_core.ident.ladder import rest_offset
+    assert rest_offset(np.array([mean - 0.05, mean + 0.05])) == pytest.approx(bias, abs=1e-12)
 
 
 @pytest.mark.slow

@@ -441,6 +441,14 @@ def unresolved(model: Model, std: dict, name: str) -> list[str]:
     return []
 
 
+def rest_offset(theta: np.ndarray) -> float:
+    """The mean angle's offset [rad] from the equilibrium nearest to it (upright 0, hanging +/-pi): where a
+    biased angle encoder puts a pendulum at rest (a hanging one's mean is near -pi, not a bias of -3 rad
+    against the bias's bound of 1 rad)."""
+    mean = float(np.mean(theta))
+    return mean - math.pi * round(mean / math.pi)
+
+
 def effect_starts(pr: Problem, model: Model, name: str, prior: Model) -> list[dict]:
     """Start values of effect ``name`` (several where the fit has several minima); a start may
     also name other parameters of ``model`` (``prior``: the declared model)."""
@@ -460,7 +468,7 @@ def effect_starts(pr: Problem, model: Model, name: str, prior: Model) -> list[di
     if name == 'drive_backlash':
         return drive_starts(pr, model, prior)
     if name == 'sensor_bias':
-        return [{'bias_theta_rad': float(np.mean(rec.theta)) if rec.theta is not None else 0.0}]
+        return [{'bias_theta_rad': rest_offset(rec.theta) if rec.theta is not None else 0.0}]
     if name == 'lag':
         return [{'input_lag_s': tau} for tau in (0.003, 0.01, 0.03)]
     return [{}]
