@@ -33,7 +33,8 @@ from ..physics.plant import held_forces, pendulum_residuals, required_forces
 from . import effects as fx
 from .residual import signature_scores
 
-__all__ = ['base_fit', 'structure_fit', 'force_error', 'signatures_left', 'identify_steady']
+__all__ = ['Prepared', 'balance', 'parts', 'base_fit', 'structure_fit', 'force_error', 'signatures_left',
+           'identify_steady']
 
 EDGE_S = 0.15
 TICK_S = 0.02
