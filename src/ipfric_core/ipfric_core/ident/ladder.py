@@ -532,7 +532,7 @@ def drive_starts(pr: Problem, model: Model, prior: Model, keep: int = 2, masses=
     with the friction of the declared model ``prior`` (a refit without the play distorts it: the
     Coulomb level sinks where the cart coasts through the play). ``masses``: the motor sides [kg] to try
     instead of the grid's shares of the cart's mass; ``gaps``: the plays [m] instead of the grid's."""
-    grid_gaps, shares, freqs, zeta = DRIVE_GRID
+    grid_gaps, shares, freqs, _ = DRIVE_GRID
     gaps = gaps or grid_gaps
     law = {n: prior[n] for n in LAW_PARAMS[prior.law]}
     model = model.with_values(law)
@@ -542,7 +542,7 @@ def drive_starts(pr: Problem, model: Model, prior: Model, keep: int = 2, masses=
         for f in freqs:
             k = reduced * (2 * math.pi * f) ** 2
             grid += [{'drive_backlash_m': g, 'drive_mass_kg': mass, 'drive_stiffness_N_per_m': k,
-                      'drive_damping_Ns_per_m': 2 * zeta * math.sqrt(k * reduced), **law} for g in gaps]
+                      'drive_damping_Ns_per_m': contact_damping(k, mass, model['M']), **law} for g in gaps]
     costs = [pr.cart_cost(model.with_effect('drive_backlash', p).with_values(p)) for p in grid]
     return [grid[i] for i in np.argsort(costs)[:keep]]
 
@@ -781,9 +781,14 @@ def contact_held(model: Model) -> dict:
     p = model.param('drive_damping_Ns_per_m') if 'drive_backlash' in model.effects else None
     if p is None or not p.free or p not in bound_params(model):
         return {}
-    mb, mc = model['drive_mass_kg'], model['M']
-    reduced = mb * mc / (mb + mc)
-    return {p.name: 2 * DRIVE_GRID[3] * math.sqrt(model['drive_stiffness_N_per_m'] * reduced)}
+    return {p.name: contact_damping(model['drive_stiffness_N_per_m'], model['drive_mass_kg'], model['M'])}
+
+
+def contact_damping(stiffness: float, motor: float, cart: float) -> float:
+    """The damping [N s/m] of a drive's contact of ``stiffness`` [N/m] between a motor side and a cart of
+    those masses [kg] at the damping ratio of :data:`DRIVE_GRID` (on their reduced mass)."""
+    reduced = motor * cart / (motor + cart)
+    return 2 * DRIVE_GRID[3] * math.sqrt(stiffness * reduced)
 
 
 def errors_of(pe: Problem, h: Hypothesis, model: Model, prior: Model) -> dict:
