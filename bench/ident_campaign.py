@@ -3,6 +3,7 @@ that shares nothing with ipfric_core), each identified by ``ipfric identify`` an
 
     python -m bench.ident_campaign --out runs/campaign --cases 40 --seed 1 [--threshold 2]
     python -m bench.ident_campaign --out runs/campaign --rescore      # score existing results again
+    python -m bench.ident_campaign --out runs/campaign --cases 200 --seed 1 --resume   # go on after a stop
 
 A case's expected answer: the library effect(s) whose own contribution (truth
 ``contribution_counts_rms``: multiple shooting on 1 s windows, cart encoder counts; angle counts
@@ -167,6 +168,19 @@ def identify_command(case_dir: Path, truth: dict) -> list[str]:
     if not truth['pendulum_attached']:
         cmd.append('--cart-alone')
     return cmd
+
+
+def code_commit() -> str:
+    """The commit of the tree that identifies (``+dirty`` when it has uncommitted changes; ``unknown``
+    outside git): a campaign continued with --resume must be one code's answers."""
+    try:
+        head = subprocess.run(['git', 'rev-parse', '--short', 'HEAD'], cwd=ROOT, capture_output=True, text=True,
+                              check=True).stdout.strip()
+        dirty = subprocess.run(['git', 'status', '--porcelain', '--untracked-files=no'], cwd=ROOT,
+                               capture_output=True, text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return 'unknown'
+    return head + ('+dirty' if dirty else '')
 
 
 def identify_case(case_dir: Path, truth: dict, timeout: float = TIMEOUT) -> dict:
@@ -368,7 +382,8 @@ def _fmt(v, nd=3):
 
 def write_markdown(s: dict, path: Path) -> None:
     tg = targets(s)
-    L = [f'# Identification campaign: {s["n_cases"]} cases, seed {s["meta"].get("seed")}', '',
+    L = [f'# Identification campaign: {s["n_cases"]} cases, seed {s["meta"].get("seed")}, code '
+         f'{s["meta"].get("commit", "unknown")}', '',
          f'Threshold {s["threshold_counts"]:g} counts RMS (an effect at or above it must be named). '
          f'Right (correct, alike or acceptable): {100 * s["right_share"]:.0f} %. Outcomes: '
          + ', '.join(f'{k} {v}' for k, v in sorted(s['outcomes'].items())) + '.', '',
@@ -475,28 +490,65 @@ def write_summary(out_dir: Path, cases: list[dict], threshold: float, meta: dict
 
 
 # ------------------------------------------------------------------------------------- driver
+def done_cases(out_dir: Path, seed: int, commit: str) -> set[str]:
+    """The cases of ``out_dir`` already identified by the code of ``commit`` from the draw of ``seed`` (what
+    --resume keeps). A directory of another seed, or cases of another code, is refused: one summary is one
+    code's answers to one draw."""
+    manifest = out_dir / 'cases' / 'manifest.json'
+    if not manifest.exists():
+        return set()
+    old_seed = json.loads(manifest.read_text()).get('seed')
+    if old_seed != seed:
+        raise SystemExit(f'--resume: {out_dir} holds the draw of seed {old_seed}, not {seed}')
+    done = set()
+    for meta_p in sorted((out_dir / 'cases').glob('case*/ident/meta.json')):
+        ran = json.loads(meta_p.read_text()).get('commit')
+        if ran != commit or commit.endswith('+dirty'):
+            raise SystemExit(f'--resume: {meta_p.parent.parent.name} was identified by code {ran}, this tree is '
+                             f'{commit} (commit the changes, or start another --out)')
+        done.add(meta_p.parent.parent.name)
+    return done
+
+
 def run_campaign(out_dir, n_cases, seed, workers=1, progress=None, threshold=THRESHOLD, indices=None,
-                 timeout=TIMEOUT, generate_workers=None, with_oracle=True) -> dict:
+                 timeout=TIMEOUT, generate_workers=None, with_oracle=True, resume=False) -> dict:
     """Generate cases (seed, i), identify each (``workers`` identifications at a time), score;
     returns the summary (also written to out_dir/summary.json, summary.md, detection.png).
-    ``with_oracle``: also the identification's error of the true model on each case (:func:`oracle`)."""
+    ``with_oracle``: also the identification's error of the true model on each case (:func:`oracle`).
+    ``resume``: keep the cases already identified in ``out_dir`` by this code (:func:`done_cases`) and
+    generate and identify only the others (a campaign of hundreds of cases goes on after a stop)."""
     out_dir = Path(out_dir)
     case_root = out_dir / 'cases'
     indices = list(range(n_cases)) if indices is None else list(indices)
     say = progress or (lambda msg: None)
+    commit = code_commit()
+    done = done_cases(out_dir, seed, commit) if resume else set()
+    old = json.loads((case_root / 'manifest.json').read_text()) if done else {'generation_s': {}, 'cases': {}}
+    todo = [i for i in indices if campaign.case_name(i) not in done]
     t0 = time.perf_counter()
-    manifest = campaign.generate(case_root, len(indices), seed, indices, generate_workers or workers,
+    manifest = campaign.generate(case_root, len(todo), seed, todo, generate_workers or workers,
                                  lambda case, s: say(f'generated {case} in {s:.1f} s'))
     gen_wall = time.perf_counter() - t0
-    names = list(manifest['cases'])
+    if done:
+        say(f'resumed: {len(done)} cases already identified by {commit}, {len(todo)} to go')
+        manifest = dict(manifest, indices=sorted(set(old.get('indices', [])) | set(todo)),
+                        generation_s={**old['generation_s'], **manifest['generation_s']},
+                        cases={**old['cases'], **manifest['cases']})
+        (case_root / 'manifest.json').write_text(json.dumps(manifest, indent=1, sort_keys=True))
+    names = [campaign.case_name(i) for i in indices]
 
     def one(name):
         d = case_root / name
         truth = json.loads((d / 'truth.json').read_text())
+        if name in done:
+            ident = json.loads((d / 'ident' / 'meta.json').read_text())
+            res = d / 'ident' / 'result.json'
+            ident['result'] = json.loads(res.read_text()) if ident.get('rc') == 0 and res.exists() else None
+            return score_case(truth, ident, threshold, manifest['generation_s'].get(name), ident.get('oracle_counts'))
         ident = identify_case(d, truth, timeout)
         orc = oracle(d, truth) if with_oracle else None
         (d / 'ident' / 'meta.json').write_text(json.dumps(
-            dict({k: v for k, v in ident.items() if k != 'result'}, oracle_counts=orc)))
+            dict({k: v for k, v in ident.items() if k != 'result'}, oracle_counts=orc, commit=commit)))
         return score_case(truth, ident, threshold, manifest['generation_s'].get(name), orc)
 
     cases = []
@@ -511,7 +563,8 @@ def run_campaign(out_dir, n_cases, seed, workers=1, progress=None, threshold=THR
             c = one(name)
             cases.append(c)
             say(f'{c["case"]}: expected {c["expected"]}, answer {c["predicted"]} ({c["outcome"]}), {c["wall_s"]} s')
-    meta = dict(seed=seed, indices=indices, workers=workers, generation_wall_s=round(gen_wall, 1),
+    meta = dict(seed=seed, indices=indices, workers=workers, commit=commit, resumed_cases=len(done),
+                generation_wall_s=round(gen_wall, 1),
                 total_wall_s=round(time.perf_counter() - t0, 1),
                 date_utc=time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime()),
                 load_average_at_end=os.getloadavg())
@@ -555,13 +608,15 @@ def main(argv=None) -> int:
     ap.add_argument('--timeout', type=float, default=TIMEOUT, help='seconds per identification')
     ap.add_argument('--rescore', action='store_true', help='score the results already in --out')
     ap.add_argument('--no-oracle', action='store_true', help="skip the true model's error per case")
+    ap.add_argument('--resume', action='store_true',
+                    help='keep the cases --out already holds from this seed and this code; identify the rest')
     a = ap.parse_args(argv)
     if a.rescore:
         s = rescore(a.out, a.threshold, not a.no_oracle)
     else:
         idx = [int(i) for i in a.indices.split(',')] if a.indices else None
         s = run_campaign(a.out, a.cases, a.seed, a.workers, lambda m: print(m, flush=True), a.threshold, idx,
-                         a.timeout, with_oracle=not a.no_oracle)
+                         a.timeout, with_oracle=not a.no_oracle, resume=a.resume)
     print(Path(a.out) / 'summary.md')
     print(json.dumps({k: s[k] for k in ('outcomes', 'confusion', 'clean', 'timing')}, indent=1))
     return 0

@@ -236,3 +236,26 @@ def test_fixed_case_is_identified_right(fixed_cases, index):
     assert ident['rc'] == 0, (ident['command'], ident['stderr_tail'])
     case = scorer.score_case(truth, ident)
     assert case['predicted'] == right, (what, case['added'], case['verdict'], case['validation_counts'])
+
+
+def test_resume_keeps_the_cases_of_this_code_and_refuses_another_code_or_draw(tmp_path, monkeypatch):
+    """--resume scores a case this code already identified without running it again; cases of another
+    commit, or a directory of another seed, are refused (one summary is one code's answers to one draw)."""
+    out = tmp_path / 'camp'
+    campaign.generate(out / 'cases', 0, SEED, indices=[2], duration=12.0)
+    ident = out / 'cases' / 'case0002' / 'ident'
+    ident.mkdir()
+    (ident / 'meta.json').write_text(json.dumps({'rc': 2, 'wall_s': 1.5, 'stderr_tail': ['refused'],
+                                                  'command': './ipfric identify ...', 'oracle_counts': None,
+                                                  'commit': 'abc1234'}))
+    monkeypatch.setattr(scorer, 'code_commit', lambda: 'abc1234')
+    s = scorer.run_campaign(out, 0, SEED, indices=[2], resume=True, with_oracle=False)
+    assert s['outcomes'] == {'error': 1}
+    assert s['meta']['resumed_cases'] == 1 and s['meta']['commit'] == 'abc1234'
+    assert not (ident / 'stderr.txt').exists()          # identify_case never ran
+    assert 'code abc1234' in (out / 'summary.md').read_text()
+    monkeypatch.setattr(scorer, 'code_commit', lambda: 'def5678')
+    with pytest.raises(SystemExit, match='case0002 was identified by code abc1234, this tree is def5678'):
+        scorer.run_campaign(out, 0, SEED, indices=[2], resume=True, with_oracle=False)
+    with pytest.raises(SystemExit, match=f'holds the draw of seed {SEED}, not {SEED + 1}'):
+        scorer.run_campaign(out, 0, SEED + 1, indices=[2], resume=True, with_oracle=False)

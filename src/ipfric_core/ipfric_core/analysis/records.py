@@ -20,6 +20,7 @@ import gzip
 import math
 from array import array
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 from pathlib import Path
 from typing import IO
 
@@ -76,20 +77,21 @@ class Record:
     notes: tuple = field(default=())
     plant: PlantParams | None = None
 
-    @property
+    @cached_property
     def dt(self) -> float:
+        """The median sample period [s] (kept: the simulation error reads it at every prediction)."""
         return float(np.median(np.diff(self.t)))
 
     @property
     def valid_mask(self) -> np.ndarray:
         return np.ones(len(self.t), bool) if self.valid is None else self.valid
 
-    @property
+    @cached_property
     def x_resolution(self) -> float:
         """The cart encoder's count [m]: the smallest step of x."""
         return smallest_step(self.x)
 
-    @property
+    @cached_property
     def theta_resolution(self) -> float:
         """The angle encoder's count [rad]: the smallest step of theta."""
         return smallest_step(self.theta) if self.theta is not None else 1.0

@@ -734,7 +734,7 @@ def short_fits(pe: Problem, current: Model, hs: list[Hypothesis], prior: Model, 
     refits the whole law itself, starts from both: a refit without it may have bent the friction to
     make up for a wrong mass (a motor side that moves with the cart: the viscous slope sank to 0)."""
     out: dict[int, tuple[Model, float]] = {i: short_fit(pe, current, h, prior, ps)
-                                           for i, h in enumerate(hs) if h.label == 'refit'}
+                                           for i, h in enumerate(hs) if h.kind == 'friction'}
     seed = {}
     if out:
         refit = next(iter(out.values()))[0]
@@ -910,7 +910,7 @@ def beyond_refit(pv: Problem, current: Model, judged: list[Judged]) -> None:
     beyond the round's refit alone by the rule of :func:`drop_checks`, else the reasons are added to its
     ``refused`` (a sensor bias kept in a balancing loop for 6 % over the refit, where a spring from
     outside the library pulled the cart)."""
-    refit = next((j for j in judged if j.h.label == 'refit'), None)
+    refit = next((j for j in judged if j.h.kind == 'friction'), None)
     if refit is None:
         return
     law = LAW_PARAMS[current.law]
@@ -959,7 +959,7 @@ def screen(hs: list[Hypothesis], short: list[tuple[Model, float]], pe: Problem, 
     (:func:`contradictions`) is refused here and takes no place in its group. A hypothesis is fitted in
     full when its gain reaches SCREEN_GAIN and FULL_SHARE of the best of its group's, and it is among the
     FULL_TOP best of it."""
-    refit = next((m for h, (m, _) in zip(hs, short) if h.label == 'refit'), None)
+    refit = next((m for h, (m, _) in zip(hs, short) if h.kind == 'friction'), None)
     base = pe.cost(refit) if refit is not None else None
     gains = []
     refuted = []

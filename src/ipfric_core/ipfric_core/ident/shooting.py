@@ -68,13 +68,12 @@ class Windows:
         return len(self.start)
 
 
-def local_rate(t: np.ndarray, y: np.ndarray, k: int, valid: np.ndarray, half_s: float = 0.01) -> float:
+def local_rate(t: np.ndarray, y: np.ndarray, k: int, valid: np.ndarray, dt: float, half_s: float = 0.01) -> float:
     """dy/dt at sample k [unit/s]: slope of a quadratic fitted over the ``valid`` samples nearest
-    to k, as many each side as +/- ``half_s`` holds at the median period (at least two), which
+    to k, as many each side as +/- ``half_s`` holds at the median period ``dt`` [s] (at least two), which
     follows a quantized signal through fast changes. A stale reading repeats an old position at
     a new time: beside a sample overrun it would bend the fit by the motion it missed, so the fit
     reaches past it to the fresh readings on that side."""
-    dt = float(np.median(np.diff(t)))
     h = max(2, int(round(half_s / dt)))
     idx = np.flatnonzero(valid)
     at = int(np.searchsorted(idx, k))
@@ -85,14 +84,15 @@ def local_rate(t: np.ndarray, y: np.ndarray, k: int, valid: np.ndarray, half_s: 
 
 def still(t: np.ndarray, x: np.ndarray) -> np.ndarray:
     """True at samples whose encoder reading equals every reading within +/- STILL_S."""
-    same_before = np.zeros(len(x), bool)
     moves = np.concatenate([[0], np.flatnonzero(np.diff(x) != 0.0) + 1, [len(x)]])
-    for a, b in zip(moves[:-1], moves[1:]):
-        # samples a..b-1 share one reading; inside by STILL_S from both ends
-        lo = np.searchsorted(t, t[a] + STILL_S)
-        hi = np.searchsorted(t, t[b - 1] - STILL_S, side='right')
-        same_before[lo:hi] = True
-    return same_before
+    # samples a..b-1 share one reading; inside by STILL_S from both ends (the runs do not overlap)
+    lo = np.searchsorted(t, t[moves[:-1]] + STILL_S)
+    hi = np.searchsorted(t, t[moves[1:] - 1] - STILL_S, side='right')
+    keep = lo < hi
+    edge = np.zeros(len(x) + 1, int)
+    np.add.at(edge, lo[keep], 1)
+    np.add.at(edge, hi[keep], -1)
+    return np.cumsum(edge[:-1]) > 0
 
 
 def make_windows(rec: Record, length_s: float, forced: bool = False, span: float = REST_SPAN) -> Windows:
@@ -143,8 +143,8 @@ def windows_at(rec: Record, start: np.ndarray, stop: np.ndarray, forced: bool = 
     t, x = rec.t, rec.x
     th = rec.theta if rec.theta is not None else np.zeros_like(x)
     held = (still(t, x) & usable(rec))[start].astype(float)
-    v = np.array([0.0 if h else local_rate(t, x, k, rec.valid_mask) for k, h in zip(start, held)])
-    w = (np.array([local_rate(t, th, k, rec.valid_mask) for k in start]) if rec.theta is not None
+    v = np.array([0.0 if h else local_rate(t, x, k, rec.valid_mask, rec.dt) for k, h in zip(start, held)])
+    w = (np.array([local_rate(t, th, k, rec.valid_mask, rec.dt) for k in start]) if rec.theta is not None
          else np.zeros(len(start)))
     state = np.column_stack([x[start], th[start], v, w, np.zeros(len(start))])
     angle = (np.column_stack([th, smooth_rate(t, th, rec.valid_mask, FILTER_HZ)]) if forced else np.zeros((0, 2)))
@@ -360,7 +360,7 @@ def predict(model, rec: Record, win: Windows) -> Prediction:
               if drive[0] > 0.0 else np.zeros((len(win), 3)))
     _shoot(model.pp, model.fp, tr.force_vector(), tr.deadzone_V, tr.saturation_V, tr.backlash_m, tr.bias_theta_rad,
            drive, drive0, rec.t, first, durations, commands, win.start, win.stop,
-           win.state, win.held, min(1e-3, float(np.median(np.diff(rec.t)))), win.forced,
+           win.state, win.held, min(1e-3, rec.dt), win.forced,
            rec.theta if rec.theta is not None else np.zeros(len(rec.t)), rec.x, fit_n, rate_step, out)
     window_of = np.full(len(rec.t), -1)
     for i, (a, b) in enumerate(zip(win.start, win.stop)):
