@@ -760,12 +760,15 @@ def joint(h: Hypothesis, model: Model) -> set:
 
 def full_fit(pe: Problem, h: Hypothesis, best: Model, prior: Model) -> Model:
     """The fit of the hypothesis's parameters with every parameter the model already fits (:func:`joint`),
-    from its short fit ``best``. A refit of the declared law that puts one of its levels on a bound is
-    done again with that level held at its declared value: the data did not determine it (below the
-    Stribeck velocity the Coulomb level and the curve's width trade), and a bound is no answer."""
+    from its short fit ``best``. A refit of the declared law that puts one of its levels on a bound, or its
+    Coulomb level within two standard errors of zero (:func:`untold`), is done again with that level held
+    at its declared value: the data did not determine it (below the Stribeck velocity the Coulomb level and
+    the curve's width trade), and neither a bound nor a cart without Coulomb friction is an answer."""
     m = fit_model(pe, best, only=joint(h, best), prior=prior, errors=False)[0]
     if h.kind == 'friction':
         held = {p.name: prior[p.name] for p in bound_params(m) if p.name in LAW_PARAMS[m.law]}
+        if not held and untold(m, errors_of(pe, h, m, prior)):
+            held = {'Fc': prior['Fc']}
     else:
         held = contact_held(m)
     if held:
@@ -1119,8 +1122,8 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
         label = {'friction': 'refit', 'law': win.h.label, 'plant': win.h.label}.get(win.h.kind, f'+ {win.h.effect}')
         step_notes = correction_notes(declared, current, s, est.theta is None) if win.h.kind == 'plant' else []
         step_notes += refit_notes(declared, current) if win.h.kind in ('friction', 'law', 'plant') else []
-        step_notes += [f'{p.name} held at its declared {p.value:.4g} {p.unit}: the refit put it on a bound, the data '
-                       'do not determine it' for p in current.params
+        step_notes += [f'{p.name} held at its declared {p.value:.4g} {p.unit}: the data do not determine it (the refit '
+                       'put it on a bound, or a Coulomb level within two standard errors of zero)' for p in current.params
                        if win.h.kind == 'friction' and p.name in LAW_PARAMS[current.law] and not p.free]
         step_notes += [f'{p.name} held at {p.value:.4g} {p.unit} (damping ratio {DRIVE_GRID[3]:g}): the fit put it '
                        'on a bound, the data do not determine it' for p in current.params
