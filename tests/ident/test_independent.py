@@ -116,6 +116,44 @@ def test_a_friction_rising_with_speed_is_found_in_independent_data(tmp_path):
     assert res['verdict']['explained'], res['verdict']
 
 
+@pytest.mark.slow
+def test_a_cart_without_coulomb_friction_is_answered_by_the_viscous_law(tmp_path):
+    """The independent simulator's cart on an air bearing (no Coulomb or static friction: mu_s = mu_c = 0,
+    viscous 3 N s/m), 45 s, declared with the paper's Stribeck curve: the refit loses its Coulomb level to
+    its bound, which refutes the declared law there; the viscous law is fitted in full and kept, its slope
+    within 3 %, nothing on a bound, explained down to the encoders' floor."""
+    spec = dict(rigsim._case('quanser', 'cart', seed=52), rig_overrides={'mu_s': 0.0, 'mu_c': 0.0})
+    rec = load(rigsim.write_case('air', tmp_path, data=rigsim.simulate(spec, duration=45.0)), None)
+    est, val = rec.split(0.6)
+    res = run_ladder(est, val, load_declared(None, 'exponential', False))
+    final = res['steps'][-1].model
+    assert final.law == 'viscous' and final.effects == (), res['tried']
+    assert final['eps'] == pytest.approx(3.0, rel=0.03)
+    assert not [p.name for p in final.params if p.at_bound(1e-3 * PARAMS[p.name].typical)]
+    assert res['verdict']['explained'], res['verdict']
+
+
+def test_a_refit_on_a_bound_has_the_leaner_laws_fitted_in_full(data):
+    """The screen of a round (``ladder.screen``) on the independent clean cart record: where the refit's
+    short fit ends with its Coulomb level on the bound 0, the viscous and Coulomb laws are fitted in full
+    even when five hypotheses gained more (outside the ranks); the dynamic law, with more parts, is not;
+    with the Coulomb level off its bound they are ranked as any other."""
+    from ipfric_core.ident.ladder import Problem, hypotheses, screen
+    rec = load(data['cart_none'], None, cart_alone=True)
+    est, _ = rec.split(0.6)
+    pe = Problem(est)
+    declared = load_declared(None, 'exponential', False)
+    hs = [h for h in hypotheses(pe, declared, declared) if h.kind != 'effect' or not set(h.free) - set(h.own)]
+    gains = {'friction': 0.5, 'law': 0.4, 'plant': 0.6, 'effect': 0.7}     # every effect on the declared friction
+    for fc, forced in ((0.0, True), (0.3, False)):
+        refit = declared.with_free(('Fc', 'Fs_excess', 'eps', 'v_s')).with_values({'Fc': fc})
+        short = [(refit if h.kind == 'friction' else h.model, gains[h.kind]) for h in hs]
+        notes = dict(zip((h.label for h in hs), screen(hs, short, pe, declared)))
+        assert notes['refit'] is None
+        assert (notes['law viscous'] is None) == forced and (notes['law coulomb'] is None) == forced, notes
+        assert 'not among the 3 best' in notes['law dynamic']
+
+
 @pytest.mark.parametrize('factor', [1.0, 0.75, 1.3])
 def test_force_balance_starts_the_mass_and_friction_from_a_wrong_declaration(data, factor):
     """The refit's and the plant corrections' starts from the cart's force balance

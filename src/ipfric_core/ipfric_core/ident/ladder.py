@@ -765,13 +765,18 @@ def full_fit(pe: Problem, h: Hypothesis, best: Model, prior: Model) -> Model:
     at its declared value: the data did not determine it (below the Stribeck velocity the Coulomb level and
     the curve's width trade), and neither a bound nor a cart without Coulomb friction is an answer."""
     m = fit_model(pe, best, only=joint(h, best), prior=prior, errors=False)[0]
-    if h.kind == 'friction':
-        held = {p.name: prior[p.name] for p in bound_params(m) if p.name in LAW_PARAMS[m.law]}
-        if not held and untold(m, errors_of(pe, h, m, prior)):
-            held = {'Fc': prior['Fc']}
-    else:
+    if h.kind != 'friction':
         held = contact_held(m)
-    if held:
+        return fit_model(pe, m.holding(held), only=joint(h, best) - set(held), prior=prior, errors=False)[0] \
+            if held else m
+    held: dict = {}
+    for _ in LAW_PARAMS[m.law]:      # a level held, another may go to its bound: until none does
+        new = {p.name: prior[p.name] for p in bound_params(m) if p.name in LAW_PARAMS[m.law]}
+        if not new and 'Fc' not in held and untold(m, errors_of(pe, h, m, prior)):
+            new = {'Fc': prior['Fc']}
+        if not new:
+            break
+        held.update(new)
         m = fit_model(pe, m.holding(held), only=joint(h, best) - set(held), prior=prior, errors=False)[0]
     return m
 
@@ -961,27 +966,34 @@ def screen(hs: list[Hypothesis], short: list[tuple[Model, float]], pe: Problem, 
     for free); the others by their gain over ``current``. A short fit the data already contradict
     (:func:`contradictions`) is refused here and takes no place in its group. A hypothesis is fitted in
     full when its gain reaches SCREEN_GAIN and FULL_SHARE of the best of its group's, and it is among the
-    FULL_TOP best of it; the refit of the declared law whenever it reaches SCREEN_GAIN (the hypotheses that
-    carry it must beat it: :func:`beyond_refit`; screened out, it left a balancing loop with nothing kept
-    where it alone explained 37 % of the validation error)."""
+    FULL_TOP best of it. Fitted in full whenever they reach SCREEN_GAIN, outside the ranks: the refit of the
+    declared law (the hypotheses that carry it must beat it: :func:`beyond_refit`; screened out by rank, it
+    left a balancing loop with nothing kept where it alone explained 37 % of the validation error), and the
+    leaner laws where the refit's short fit ends on a bound (the declared law is refuted there, and a law
+    with more parts ends on the same bound: a cart logged at 30 ms whose refit lost its Coulomb level kept
+    nothing, the viscous law ranked fourth)."""
     refit = next((m for h, (m, _) in zip(hs, short) if h.kind == 'friction'), None)
     base = pe.cost(refit) if refit is not None else None
+    refuted_law = refit is not None and any(p.name in LAW_PARAMS[refit.law] for p in bound_params(refit))
     gains = []
     refuted = []
+    forced = []
     for h, (m, g) in zip(hs, short):
         levels = bool(set(h.free) - set(h.own)) and h.kind == 'effect'
         gains.append((levels, 1.0 - pe.cost(m) / base if levels and base else g))
         why = contradictions(pe, m, h.effect) if h.effect and g >= SCREEN_GAIN else []
         refuted.append('its short fit: ' + '; '.join(why) if why else None)
-    alive = [(lv, g) for (lv, g), r in zip(gains, refuted) if r is None]
+        leaner = h.kind == 'law' and len(h.own) < len(LAW_PARAMS[current.law])
+        forced.append(g >= SCREEN_GAIN and (h.kind == 'friction' or (leaner and refuted_law)))
+    alive = [(lv, g) for (lv, g), r, f in zip(gains, refuted, forced) if r is None and not f]
     top = {grp: max([g for lv, g in alive if lv == grp], default=0.0) for grp in (True, False)}
     rank = {grp: sorted((g for lv, g in alive if lv == grp), reverse=True) for grp in (True, False)}
     out: list[str | None] = []
-    for h, (lv, g), r in zip(hs, gains, refuted):
+    for (lv, g), r, f in zip(gains, refuted, forced):
         what = 'beyond the refit\'s' if lv else 'over the model\'s'
         if r is not None:
             out.append(r)
-        elif h.kind == 'friction' and g >= SCREEN_GAIN:
+        elif f:
             out.append(None)
         elif g < SCREEN_GAIN:
             out.append(f'its short fit lowers the estimation error by {100 * g:.2g} % {what} only')
@@ -1123,7 +1135,8 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
         step_notes = correction_notes(declared, current, s, est.theta is None) if win.h.kind == 'plant' else []
         step_notes += refit_notes(declared, current) if win.h.kind in ('friction', 'law', 'plant') else []
         step_notes += [f'{p.name} held at its declared {p.value:.4g} {p.unit}: the data do not determine it (the refit '
-                       'put it on a bound, or a Coulomb level within two standard errors of zero)' for p in current.params
+                       'put it on a bound, or a Coulomb level within two standard errors of zero)'
+                       for p in current.params
                        if win.h.kind == 'friction' and p.name in LAW_PARAMS[current.law] and not p.free]
         step_notes += [f'{p.name} held at {p.value:.4g} {p.unit} (damping ratio {DRIVE_GRID[3]:g}): the fit put it '
                        'on a bound, the data do not determine it' for p in current.params
