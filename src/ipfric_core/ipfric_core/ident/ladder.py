@@ -766,9 +766,9 @@ def full_fit(pe: Problem, h: Hypothesis, best: Model, prior: Model) -> Model:
     the curve's width trade), and neither a bound nor a cart without Coulomb friction is an answer."""
     m = fit_model(pe, best, only=joint(h, best), prior=prior, errors=False)[0]
     if h.kind != 'friction':
-        held = contact_held(m)
-        return fit_model(pe, m.holding(held), only=joint(h, best) - set(held), prior=prior, errors=False)[0] \
-            if held else m
+        contact = contact_held(m)
+        return fit_model(pe, m.holding(contact), only=joint(h, best) - set(contact), prior=prior, errors=False)[0] \
+            if contact else m
     held: dict = {}
     for _ in LAW_PARAMS[m.law]:      # a level held, another may go to its bound: until none does
         new = {p.name: prior[p.name] for p in bound_params(m) if p.name in LAW_PARAMS[m.law]}
