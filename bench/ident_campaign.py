@@ -502,7 +502,10 @@ def done_cases(out_dir: Path, seed: int, commit: str) -> set[str]:
         raise SystemExit(f'--resume: {out_dir} holds the draw of seed {old_seed}, not {seed}')
     done = set()
     for meta_p in sorted((out_dir / 'cases').glob('case*/ident/meta.json')):
-        ran = json.loads(meta_p.read_text()).get('commit')
+        meta = json.loads(meta_p.read_text())
+        if isinstance(meta.get('rc'), int) and meta['rc'] < 0:
+            continue                    # killed by a signal (the campaign stopped): identified again
+        ran = meta.get('commit')
         if ran != commit or commit.endswith('+dirty'):
             raise SystemExit(f'--resume: {meta_p.parent.parent.name} was identified by code {ran}, this tree is '
                              f'{commit} (commit the changes, or start another --out)')
@@ -526,12 +529,13 @@ def run_campaign(out_dir, n_cases, seed, workers=1, progress=None, threshold=THR
     old = json.loads((case_root / 'manifest.json').read_text()) if done else {'generation_s': {}, 'cases': {}}
     todo = [i for i in indices if campaign.case_name(i) not in done]
     t0 = time.perf_counter()
-    manifest = campaign.generate(case_root, len(todo), seed, todo, generate_workers or workers,
-                                 lambda case, s: say(f'generated {case} in {s:.1f} s'))
+    manifest = (campaign.generate(case_root, len(todo), seed, todo, generate_workers or workers,
+                                  lambda case, s: say(f'generated {case} in {s:.1f} s'))
+                if todo else {'generation_s': {}, 'cases': {}})
     gen_wall = time.perf_counter() - t0
     if done:
         say(f'resumed: {len(done)} cases already identified by {commit}, {len(todo)} to go')
-        manifest = dict(manifest, indices=sorted(set(old.get('indices', [])) | set(todo)),
+        manifest = dict(old, indices=sorted(set(old.get('indices', [])) | set(todo)),
                         generation_s={**old['generation_s'], **manifest['generation_s']},
                         cases={**old['cases'], **manifest['cases']})
         (case_root / 'manifest.json').write_text(json.dumps(manifest, indent=1, sort_keys=True))
@@ -545,10 +549,15 @@ def run_campaign(out_dir, n_cases, seed, workers=1, progress=None, threshold=THR
             res = d / 'ident' / 'result.json'
             ident['result'] = json.loads(res.read_text()) if ident.get('rc') == 0 and res.exists() else None
             return score_case(truth, ident, threshold, manifest['generation_s'].get(name), ident.get('oracle_counts'))
+        if code_commit() != commit:     # the tree changed under the campaign: its answers would be two codes'
+            raise SystemExit(f'{name}: the code changed from {commit} to {code_commit()} during the campaign '
+                             '(run it from a worktree of one commit)')
         ident = identify_case(d, truth, timeout)
         orc = oracle(d, truth) if with_oracle else None
-        (d / 'ident' / 'meta.json').write_text(json.dumps(
-            dict({k: v for k, v in ident.items() if k != 'result'}, oracle_counts=orc, commit=commit)))
+        tmp = d / 'ident' / 'meta.json.tmp'         # written whole or not at all: a stop never leaves half a file
+        tmp.write_text(json.dumps(dict({k: v for k, v in ident.items() if k != 'result'}, oracle_counts=orc,
+                                       commit=commit)))
+        os.replace(tmp, d / 'ident' / 'meta.json')
         return score_case(truth, ident, threshold, manifest['generation_s'].get(name), orc)
 
     cases = []
@@ -563,7 +572,7 @@ def run_campaign(out_dir, n_cases, seed, workers=1, progress=None, threshold=THR
             c = one(name)
             cases.append(c)
             say(f'{c["case"]}: expected {c["expected"]}, answer {c["predicted"]} ({c["outcome"]}), {c["wall_s"]} s')
-    meta = dict(seed=seed, indices=indices, workers=workers, commit=commit, resumed_cases=len(done),
+    meta = dict(seed=seed, indices=indices, workers=workers, commit=commit, resumed_cases=len(done & set(names)),
                 generation_wall_s=round(gen_wall, 1),
                 total_wall_s=round(time.perf_counter() - t0, 1),
                 date_utc=time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime()),

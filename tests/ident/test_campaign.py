@@ -254,6 +254,10 @@ def test_resume_keeps_the_cases_of_this_code_and_refuses_another_code_or_draw(tm
     assert s['meta']['resumed_cases'] == 1 and s['meta']['commit'] == 'abc1234'
     assert not (ident / 'stderr.txt').exists()          # identify_case never ran
     assert 'code abc1234' in (out / 'summary.md').read_text()
+    killed = out / 'cases' / 'case0007' / 'ident'      # stopped by a signal: not done, identified again
+    killed.mkdir(parents=True)
+    (killed / 'meta.json').write_text(json.dumps({'rc': -15, 'commit': 'abc1234'}))
+    assert scorer.done_cases(out, SEED, 'abc1234') == {'case0002'}
     monkeypatch.setattr(scorer, 'code_commit', lambda: 'def5678')
     with pytest.raises(SystemExit, match='case0002 was identified by code abc1234, this tree is def5678'):
         scorer.run_campaign(out, 0, SEED, indices=[2], resume=True, with_oracle=False)

@@ -634,13 +634,15 @@ def hypotheses(pe: Problem, current: Model, declared: Model, allowed=None, balan
     refitted (until it is), each other law, each plant correction not made yet, each library effect not
     added (``allowed`` restricts them), with the friction levels refitted and, before any refit, also
     on the declared friction alone. ``balance``: further starts of the refit and the plant corrections
-    (:func:`balance_starts`)."""
+    (:func:`balance_starts`). A law refitted with some of its levels held (:func:`full_fit`) counts as
+    refitted, and the held ones stay held: the data did not determine them."""
     rec = pe.rec
     law = LAW_PARAMS[current.law]
-    levels = tuple(n for n in ('Fc', 'Fs_excess') if n in law)
+    refitted = any(current.param(n).free for n in law)
+    levels = tuple(n for n in ('Fc', 'Fs_excess') if n in law and (current.param(n).free or not refitted))
     balance = balance or {}
     out = []
-    if not current.fitted(law):
+    if not refitted:
         out.append(Hypothesis('refit', 'friction', current.with_free(law), law, law,
                               [{}] + ([balance['refit']] if 'refit' in balance else [])))
     for other in LAWS:
@@ -654,7 +656,6 @@ def hypotheses(pe: Problem, current: Model, declared: Model, allowed=None, balan
         if not current.param(name).free:
             out.append(Hypothesis(f'{name} corrected', 'plant', current.with_free((name,) + law), (name,),
                                   (name,) + law, [{}] + ([balance[name]] if name in balance else [])))
-    refitted = current.fitted(law)
     for name in LADDER_EFFECTS:
         if name in current.effects or (allowed is not None and name not in allowed):
             continue
@@ -765,11 +766,12 @@ def full_fit(pe: Problem, h: Hypothesis, best: Model, prior: Model) -> Model:
     at its declared value: the data did not determine it (below the Stribeck velocity the Coulomb level and
     the curve's width trade), and neither a bound nor a cart without Coulomb friction is an answer."""
     m = fit_model(pe, best, only=joint(h, best), prior=prior, errors=False)[0]
+    contact = contact_held(m)
+    if contact:
+        m = fit_model(pe, m.holding(contact), only=joint(h, best) - set(contact), prior=prior, errors=False)[0]
     if h.kind != 'friction':
-        contact = contact_held(m)
-        return fit_model(pe, m.holding(contact), only=joint(h, best) - set(contact), prior=prior, errors=False)[0] \
-            if contact else m
-    held: dict = {}
+        return m
+    held: dict = dict(contact)
     for _ in LAW_PARAMS[m.law]:      # a level held, another may go to its bound: until none does
         new = {p.name: prior[p.name] for p in bound_params(m) if p.name in LAW_PARAMS[m.law]}
         if not new and 'Fc' not in held and untold(m, errors_of(pe, h, m, prior)):
