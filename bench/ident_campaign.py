@@ -603,6 +603,11 @@ def rescore(out_dir, threshold=THRESHOLD, with_oracle=False) -> dict:
     old = {}
     if (out_dir / 'summary.json').exists():
         old = json.loads((out_dir / 'summary.json').read_text()).get('meta', {})
+    elif (out_dir / 'cases' / 'manifest.json').exists():      # a campaign stopped before its summary
+        seed = json.loads((out_dir / 'cases' / 'manifest.json').read_text()).get('seed')
+        commits = sorted({json.loads(p.read_text()).get('commit') or 'unknown'
+                          for p in (out_dir / 'cases').glob('case*/ident/meta.json')})
+        old = dict(seed=seed, commit=', '.join(commits))
     return write_summary(out_dir, cases, threshold, dict(old, rescored=True))
 
 

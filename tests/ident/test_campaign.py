@@ -254,6 +254,9 @@ def test_resume_keeps_the_cases_of_this_code_and_refuses_another_code_or_draw(tm
     assert s['meta']['resumed_cases'] == 1 and s['meta']['commit'] == 'abc1234'
     assert not (ident / 'stderr.txt').exists()          # identify_case never ran
     assert 'code abc1234' in (out / 'summary.md').read_text()
+    (out / 'summary.json').unlink()                     # stopped before its summary: rescored from the cases
+    scorer.rescore(out)
+    assert f'seed {SEED}, code abc1234' in (out / 'summary.md').read_text()
     killed = out / 'cases' / 'case0007' / 'ident'      # stopped by a signal: not done, identified again
     killed.mkdir(parents=True)
     (killed / 'meta.json').write_text(json.dumps({'rc': -15, 'commit': 'abc1234'}))
