@@ -490,6 +490,15 @@ def write_summary(out_dir: Path, cases: list[dict], threshold: float, meta: dict
 
 
 # ------------------------------------------------------------------------------------- driver
+def stored_ident(case_dir: Path) -> dict:
+    """A case's identification as a campaign stored it: ident/meta.json, with ident/result.json as
+    ``result`` where the identification succeeded (else None)."""
+    ident = json.loads((case_dir / 'ident' / 'meta.json').read_text())
+    res = case_dir / 'ident' / 'result.json'
+    ident['result'] = json.loads(res.read_text()) if ident.get('rc') == 0 and res.exists() else None
+    return ident
+
+
 def done_cases(out_dir: Path, seed: int, commit: str) -> set[str]:
     """The cases of ``out_dir`` already identified by the code of ``commit`` from the draw of ``seed`` (what
     --resume keeps). A directory of another seed, or cases of another code, is refused: one summary is one
@@ -545,9 +554,7 @@ def run_campaign(out_dir, n_cases, seed, workers=1, progress=None, threshold=THR
         d = case_root / name
         truth = json.loads((d / 'truth.json').read_text())
         if name in done:
-            ident = json.loads((d / 'ident' / 'meta.json').read_text())
-            res = d / 'ident' / 'result.json'
-            ident['result'] = json.loads(res.read_text()) if ident.get('rc') == 0 and res.exists() else None
+            ident = stored_ident(d)
             return score_case(truth, ident, threshold, manifest['generation_s'].get(name), ident.get('oracle_counts'))
         if code_commit() != commit:     # the tree changed under the campaign: its answers would be two codes'
             raise SystemExit(f'{name}: the code changed from {commit} to {code_commit()} during the campaign '
@@ -590,11 +597,10 @@ def rescore(out_dir, threshold=THRESHOLD, with_oracle=False) -> dict:
         gen = json.loads((out_dir / 'cases' / 'manifest.json').read_text()).get('generation_s', {})
     for d in sorted((out_dir / 'cases').glob('case*')):
         truth = json.loads((d / 'truth.json').read_text())
-        meta_p, res_p = d / 'ident' / 'meta.json', d / 'ident' / 'result.json'
+        meta_p = d / 'ident' / 'meta.json'
         if not meta_p.exists():
             continue
-        ident = json.loads(meta_p.read_text())
-        ident['result'] = json.loads(res_p.read_text()) if ident.get('rc') == 0 and res_p.exists() else None
+        ident = stored_ident(d)
         orc = ident.get('oracle_counts')
         if orc is None and with_oracle:
             orc = oracle(d, truth)
