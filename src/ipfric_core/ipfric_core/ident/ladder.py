@@ -441,6 +441,20 @@ def unresolved(model: Model, std: dict, name: str) -> list[str]:
     return []
 
 
+def uncorrected(j_model: Model, std: dict, before: Model, names) -> list[str]:
+    """A plant correction not told from the value it corrects (``before``'s): within UNDO_SIGMA standard
+    errors of it (alpha 0.1 % low, 1.5 standard errors, kept on a clean cart for 0.06 count)."""
+    out = []
+    for n in names:
+        s = std.get(n)
+        if s is None or not math.isfinite(s):
+            out.append(f'{n} has no standard error (the data do not determine it)')
+        elif abs(j_model[n] - before[n]) <= UNDO_SIGMA * s:
+            out.append(f'{n} = {j_model[n]:.4g} +/- {s:.2g} {j_model.param(n).unit} is within {UNDO_SIGMA:g} standard '
+                       f'errors of {before[n]:.4g}: not told from it')
+    return out
+
+
 def rest_offset(theta: np.ndarray) -> float:
     """The mean angle's offset [rad] from the equilibrium nearest to it (upright 0, hanging +/-pi): where a
     biased angle encoder puts a pendulum at rest (a hanging one's mean is near -pi, not a bias of -3 rad
@@ -577,6 +591,21 @@ def law_starts(declared: Model) -> dict:
     return {n: declared.get(n, PARAMS[n].typical) for n in FRICTION_FITTED}
 
 
+#: the Stribeck velocities a law's fit also starts from, relative to its start: from the paper's 0.105 m/s a
+#: fit of a curve 0.023 m/s wide stopped at 0.15 m/s (the Coulomb level low, the viscous slope high) and
+#: lost to the coulomb law, whose lack of a curve then looked like an effect
+STRIBECK_FACTORS = (0.25, 4.0)
+
+
+def stribeck_starts(model: Model) -> list[dict]:
+    """Further starts of a law with a Stribeck curve: its Stribeck velocity times STRIBECK_FACTORS (within
+    its range); none for a law without one."""
+    if 'v_s' not in LAW_PARAMS[model.law]:
+        return []
+    p = model.param('v_s')
+    return [{'v_s': min(max(f * p.value, p.lo), p.hi)} for f in STRIBECK_FACTORS]
+
+
 #: presliding displacements [m] the bristle starts of the dynamic law are taken at (sigma0 = Fs / z)
 BRISTLE_Z = (1e-4, 1e-5)
 
@@ -644,14 +673,14 @@ def hypotheses(pe: Problem, current: Model, declared: Model, allowed=None, balan
     out = []
     if not refitted:
         out.append(Hypothesis('refit', 'friction', current.with_free(law), law, law,
-                              [{}] + ([balance['refit']] if 'refit' in balance else [])))
+                              [{}] + stribeck_starts(current) + ([balance['refit']] if 'refit' in balance else [])))
     for other in LAWS:
         if other != current.law:
             m = current.with_law(other, law_starts(declared))
             if other == 'dynamic':      # bristles stiffer than a tenth of a count of presliding are not seen
                 m = m.with_bounds('sigma0', 0.0, 10 * peak_level(m) / rec.x_resolution)
             out.append(Hypothesis(f'law {other}', 'law', m, LAW_PARAMS[other], LAW_PARAMS[other],
-                                  bristle_starts(m) if other == 'dynamic' else [{}]))
+                                  bristle_starts(m) if other == 'dynamic' else [{}] + stribeck_starts(m)))
     for name in PLANT_CORRECTIONS:
         if not current.param(name).free:
             out.append(Hypothesis(f'{name} corrected', 'plant', current.with_free((name,) + law), (name,),
@@ -761,21 +790,27 @@ def joint(h: Hypothesis, model: Model) -> set:
 
 def full_fit(pe: Problem, h: Hypothesis, best: Model, prior: Model) -> Model:
     """The fit of the hypothesis's parameters with every parameter the model already fits (:func:`joint`),
-    from its short fit ``best``. A refit of the declared law that puts one of its levels on a bound, or its
-    Coulomb level within two standard errors of zero (:func:`untold`), is done again with that level held
-    at its declared value: the data did not determine it (below the Stribeck velocity the Coulomb level and
-    the curve's width trade), and neither a bound nor a cart without Coulomb friction is an answer."""
+    from its short fit ``best``. A refit of the declared law that puts one of its levels on a bound is done
+    again with that level held at its declared value, and any hypothesis that fits the Coulomb level and
+    ends with it within two standard errors of zero (:func:`untold`) with it held at its value in the
+    hypothesis's start model (the declared one, or the one an earlier round fitted): the data did not
+    determine it (below the Stribeck velocity the Coulomb level and the curve's width trade; a balancing
+    loop's cart seldom stops), and neither a bound nor a cart without Coulomb friction is an answer (an
+    amplifier clipping at 2.7 V that explained a balancing loop to its floor was refused for an Fc of
+    0.07 +/- 0.13 N)."""
     m = fit_model(pe, best, only=joint(h, best), prior=prior, errors=False)[0]
     contact = contact_held(m)
     if contact:
         m = fit_model(pe, m.holding(contact), only=joint(h, best) - set(contact), prior=prior, errors=False)[0]
-    if h.kind != 'friction':
+    fits_fc = 'Fc' in {p.name for p in m.free}
+    if h.kind != 'friction' and not fits_fc:
         return m
     held: dict = dict(contact)
     for _ in LAW_PARAMS[m.law]:      # a level held, another may go to its bound: until none does
-        new = {p.name: prior[p.name] for p in bound_params(m) if p.name in LAW_PARAMS[m.law]}
-        if not new and 'Fc' not in held and untold(m, errors_of(pe, h, m, prior)):
-            new = {'Fc': prior['Fc']}
+        new = {p.name: prior[p.name] for p in bound_params(m)
+               if h.kind == 'friction' and p.name in LAW_PARAMS[m.law]}
+        if not new and fits_fc and 'Fc' not in held and untold(m, errors_of(pe, h, m, prior)):
+            new = {'Fc': h.model['Fc']}
         if not new:
             break
         held.update(new)
@@ -949,16 +984,29 @@ def leaner_first(passing: list[Judged], pv: Problem) -> list[Judged]:
 
 def confirm(pe: Problem, pv: Problem, current: Model, j: Judged, prior: Model) -> None:
     """The checks of a hypothesis that passed :func:`judge` which need its standard errors (its size told
-    from zero, a Coulomb level told from zero) and its contribution to the simulated motion; the reasons
-    it fails them are added to ``j.refused``."""
+    from zero, a plant correction told from the value it corrects, a Coulomb level told from zero) and its
+    contribution to the simulated motion; the reasons it fails them are added to ``j.refused``."""
     j.std = errors_of(pe, j.h, j.model, prior)
     why = untold(j.model, j.std) + (unresolved(j.model, j.std, j.h.effect) if j.h.effect else [])
+    if j.h.kind == 'plant':
+        why += uncorrected(j.model, j.std, current, j.h.own)
     if not why:
-        size = contribution(pv, j.model, j.model.without(j.h.effect) if j.h.effect else current)
+        size = contribution(pv, j.model, undone(j, current))
         if size < CONTRIBUTION_COUNTS:
             why.append(f'it changes the simulated motion by {size:.2g} counts RMS (needs {CONTRIBUTION_COUNTS:g}: '
                        f'too small to matter at the encoders)')
     j.refused += why
+
+
+def undone(j: Judged, current: Model) -> Model:
+    """``j``'s model without what its hypothesis adds: the effect removed, a plant correction's constant
+    back at its value in ``current`` with the friction as fitted beside it (a mass corrected by 0.1 % that
+    rode in on the refit's friction is no correction), a law or a refit ``current`` itself."""
+    if j.h.effect:
+        return j.model.without(j.h.effect)
+    if j.h.kind == 'plant':
+        return j.model.with_values({n: current[n] for n in j.h.own})
+    return current
 
 
 def screen(hs: list[Hypothesis], short: list[tuple[Model, float]], pe: Problem, current: Model
@@ -1136,10 +1184,10 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
         label = {'friction': 'refit', 'law': win.h.label, 'plant': win.h.label}.get(win.h.kind, f'+ {win.h.effect}')
         step_notes = correction_notes(declared, current, s, est.theta is None) if win.h.kind == 'plant' else []
         step_notes += refit_notes(declared, current) if win.h.kind in ('friction', 'law', 'plant') else []
-        step_notes += [f'{p.name} held at its declared {p.value:.4g} {p.unit}: the data do not determine it (the refit '
-                       'put it on a bound, or a Coulomb level within two standard errors of zero)'
-                       for p in current.params
-                       if win.h.kind == 'friction' and p.name in LAW_PARAMS[current.law] and not p.free]
+        step_notes += held_notes(win.h, current)
+        if win.h.kind == 'law' and 'Fc' not in LAW_PARAMS[current.law]:
+            step_notes.append('the viscous law has no Coulomb level: a real cart slides against one, and these data '
+                              'do not show it; not a final model of a real cart (the verdict says what is left)')
         step_notes += [f'{p.name} held at {p.value:.4g} {p.unit} (damping ratio {DRIVE_GRID[3]:g}): the fit put it '
                        'on a bound, the data do not determine it' for p in current.params
                        if p.name == 'drive_damping_Ns_per_m' and not p.free]
@@ -1183,6 +1231,17 @@ def undo_corrections(pe: Problem, pv: Problem, declared: Model, current: Model, 
         say(f'{name} as declared: validation x error {after:.3g} counts (with the correction {before:.3g})')
         current = m
     return current
+
+
+def held_notes(h: Hypothesis, model: Model) -> list[str]:
+    """The friction levels hypothesis ``h`` set out to fit that :func:`full_fit` held, and why."""
+    out = []
+    for p in model.params:
+        if p.name in h.free and p.name in LAW_PARAMS[model.law] and not p.free:
+            why = ('it ended on its bound, or within two standard errors of zero' if p.name == 'Fc'
+                   else 'the refit put it on a bound')
+            out.append(f'{p.name} held at {p.value:.4g} {p.unit}: the data do not determine it ({why})')
+    return out
 
 
 def _alternative(j: Judged, pv: Problem) -> dict:
