@@ -170,17 +170,22 @@ def identify_command(case_dir: Path, truth: dict) -> list[str]:
     return cmd
 
 
+#: the paths whose code makes a case and its answer: the identification (with the physics it calls) and
+#: the independent generator; a commit that touches only others (docs, the scorer, ROS) keeps the answers
+ANSWER_PATHS = ('src/ipfric_core', 'tests/independent')
+
+
 def code_commit() -> str:
-    """The commit of the tree that identifies (``+dirty`` when it has uncommitted changes; ``unknown``
-    outside git): a campaign continued with --resume must be one code's answers."""
+    """The last commit that changed :data:`ANSWER_PATHS` (``+dirty`` when they have uncommitted changes;
+    ``unknown`` outside git): a campaign continued with --resume must be one code's answers."""
     try:
-        head = subprocess.run(['git', 'rev-parse', '--short', 'HEAD'], cwd=ROOT, capture_output=True, text=True,
-                              check=True).stdout.strip()
-        dirty = subprocess.run(['git', 'status', '--porcelain', '--untracked-files=no'], cwd=ROOT,
-                               capture_output=True, text=True, check=True).stdout.strip()
+        head = subprocess.run(['git', 'log', '-1', '--format=%h', '--', *ANSWER_PATHS], cwd=ROOT,
+                              capture_output=True, text=True, check=True).stdout.strip()
+        dirty = subprocess.run(['git', 'status', '--porcelain', '--untracked-files=no', '--', *ANSWER_PATHS],
+                               cwd=ROOT, capture_output=True, text=True, check=True).stdout.strip()
     except (OSError, subprocess.CalledProcessError):
         return 'unknown'
-    return head + ('+dirty' if dirty else '')
+    return (head or 'unknown') + ('+dirty' if dirty else '')
 
 
 def identify_case(case_dir: Path, truth: dict, timeout: float = TIMEOUT) -> dict:

@@ -67,8 +67,10 @@ def data(tmp_path_factory):
     return paths
 
 
-#: the cases of the default run (one clean and one effect for each experiment); the others are marked long
-IN_SUITE = ('cart_none', 'cart_deadzone', 'loop_none', 'loop_delay', 'loop_bias')
+#: the cases of the default run (a clean record and an effect for the closed loop, a clean cart); the others
+#: are marked long (the default run's campaign cases cover a deadzone, an offset and a drive on other rigs:
+#: tests/ident/test_campaign.py)
+IN_SUITE = ('cart_none', 'loop_none', 'loop_delay', 'loop_bias')
 
 
 @pytest.mark.slow
@@ -215,7 +217,7 @@ def test_drive_play_found_sized_and_exported(data, tmp_path, capsys):
     assert truth.drive_damping_Ns_per_m == pytest.approx(final['drive_damping_Ns_per_m']['value'])
 
 
-@pytest.mark.slow
+@pytest.mark.long     # the default run's campaign cases are other rigs, with overruns (tests/ident/test_campaign.py)
 def test_other_rig_with_overruns_and_5ms_sampling_stays_plausible(data, tmp_path, capsys):
     """ip02: lighter cart, other motor; its plant file declares only the plant (the paper's
     friction is the hypothesis). The refit friction is that rig's, nothing is added, the
