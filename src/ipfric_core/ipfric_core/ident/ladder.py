@@ -441,16 +441,22 @@ def unresolved(model: Model, std: dict, name: str) -> list[str]:
     return []
 
 
-def uncorrected(j_model: Model, std: dict, before: Model, names) -> list[str]:
-    """A plant correction not told from the value it corrects (``before``'s): within UNDO_SIGMA standard
-    errors of it (alpha 0.1 % low, 1.5 standard errors, kept on a clean cart for 0.06 count)."""
+def near(value: float, ref: float, s) -> bool:
+    """``value`` within UNDO_SIGMA standard errors ``s`` of ``ref`` (a correction not told from the value it
+    corrects); False where ``s`` is missing or not finite."""
+    return s is not None and math.isfinite(s) and abs(value - ref) <= UNDO_SIGMA * s
+
+
+def uncorrected(model: Model, std: dict, before: Model, names) -> list[str]:
+    """A plant correction not told from the value it corrects (``before``'s: :func:`near`), or without a
+    standard error (alpha 0.1 % low, 1.5 standard errors, kept on a clean cart for 0.06 count)."""
     out = []
     for n in names:
         s = std.get(n)
         if s is None or not math.isfinite(s):
             out.append(f'{n} has no standard error (the data do not determine it)')
-        elif abs(j_model[n] - before[n]) <= UNDO_SIGMA * s:
-            out.append(f'{n} = {j_model[n]:.4g} +/- {s:.2g} {j_model.param(n).unit} is within {UNDO_SIGMA:g} standard '
+        elif near(model[n], before[n], s):
+            out.append(f'{n} = {model[n]:.4g} +/- {s:.2g} {model.param(n).unit} is within {UNDO_SIGMA:g} standard '
                        f'errors of {before[n]:.4g}: not told from it')
     return out
 
@@ -1218,8 +1224,7 @@ def undo_corrections(pe: Problem, pv: Problem, declared: Model, current: Model, 
     for name in PLANT_CORRECTIONS:
         p = current.param(name)
         s = std.get(name) if isinstance(std, dict) else None
-        if not p.free or declared.param(name).free or s is None or not math.isfinite(s) \
-                or abs(p.value - declared[name]) > UNDO_SIGMA * s:
+        if not p.free or declared.param(name).free or not near(p.value, declared[name], s):
             continue
         m, s2 = fit_model(pe, current.holding({name: declared[name]}), prior=declared)
         before, after = pv.summary(current)['x_rms_counts'], pv.summary(m)['x_rms_counts']
