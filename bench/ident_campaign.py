@@ -4,6 +4,7 @@ that shares nothing with ipfric_core), each identified by ``ipfric identify`` an
     python -m bench.ident_campaign --out runs/campaign --cases 40 --seed 1 [--threshold 2]
     python -m bench.ident_campaign --out runs/campaign --rescore      # score existing results again
     python -m bench.ident_campaign --out runs/campaign --cases 200 --seed 1 --resume   # go on after a stop
+    python -m bench.ident_campaign --out runs/all --merge runs/part1 runs/part2/summary.json   # one summary
 
 A case's expected answer: the library effect(s) whose own contribution (truth
 ``contribution_counts_rms``: multiple shooting on 1 s windows, cart encoder counts; angle counts
@@ -592,9 +593,10 @@ def run_campaign(out_dir, n_cases, seed, workers=1, progress=None, threshold=THR
     return write_summary(out_dir, cases, threshold, meta)
 
 
-def rescore(out_dir, threshold=THRESHOLD, with_oracle=False) -> dict:
-    """Score the identifications already in out_dir again (another threshold, a changed scorer);
-    ``with_oracle``: compute the true model's error where it is missing."""
+def scored(out_dir, threshold=THRESHOLD, with_oracle=False) -> tuple[list[dict], dict]:
+    """The cases of a campaign directory scored again, and its meta (seed, commit): of its summary, or of
+    its manifest and the cases' own records where it stopped before writing one. ``with_oracle``:
+    compute the true model's error where it is missing."""
     out_dir = Path(out_dir)
     cases = []
     gen = {}
@@ -619,7 +621,45 @@ def rescore(out_dir, threshold=THRESHOLD, with_oracle=False) -> dict:
         commits = sorted({json.loads(p.read_text()).get('commit') or 'unknown'
                           for p in (out_dir / 'cases').glob('case*/ident/meta.json')})
         old = dict(seed=seed, commit=', '.join(commits))
-    return write_summary(out_dir, cases, threshold, dict(old, rescored=True))
+    return cases, old
+
+
+def rescore(out_dir, threshold=THRESHOLD, with_oracle=False) -> dict:
+    """Score the identifications already in out_dir again (another threshold, a changed scorer);
+    ``with_oracle``: compute the true model's error where it is missing."""
+    cases, old = scored(out_dir, threshold, with_oracle)
+    return write_summary(Path(out_dir), cases, threshold, dict(old, rescored=True))
+
+
+def merge(out_dir, sources, threshold=THRESHOLD) -> dict:
+    """One summary of the cases of several parts of one campaign: each source a campaign directory
+    (scored again) or a summary.json (its scored cases, kept: a part whose cases are gone). The parts
+    must be one seed's draw identified by one code, scored at ``threshold``, each case in one part only."""
+    cases: dict[str, dict] = {}
+    seeds, commits = set(), set()
+    for src in map(Path, sources):
+        if src.is_dir():
+            rows, meta = scored(src, threshold)
+        elif src.is_file():
+            s = json.loads(src.read_text())
+            if s.get('threshold_counts') != threshold:
+                raise SystemExit(f'--merge: {src} was scored at {s.get("threshold_counts")} counts, not {threshold}')
+            rows, meta = s['cases'], s.get('meta', {})
+        else:
+            raise SystemExit(f'--merge: {src} is neither a campaign directory nor a summary.json')
+        seeds.add(meta.get('seed'))
+        commits.add(meta.get('commit'))
+        for c in rows:
+            if c['case'] in cases:
+                raise SystemExit(f'--merge: {c["case"]} is in two parts (the second: {src})')
+            cases[c['case']] = c
+    if len(seeds) > 1 or len(commits) > 1:
+        raise SystemExit(f'--merge: the parts are seeds {sorted(map(str, seeds))} and codes '
+                         f'{sorted(map(str, commits))}; one summary is one code\'s answers to one draw')
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    meta = dict(seed=seeds.pop(), commit=commits.pop(), merged=[str(s) for s in sources])
+    return write_summary(out_dir, [cases[k] for k in sorted(cases)], threshold, meta)
 
 
 def main(argv=None) -> int:
@@ -635,8 +675,12 @@ def main(argv=None) -> int:
     ap.add_argument('--no-oracle', action='store_true', help="skip the true model's error per case")
     ap.add_argument('--resume', action='store_true',
                     help='keep the cases --out already holds from this seed and this code; identify the rest')
+    ap.add_argument('--merge', nargs='+', metavar='PART',
+                    help='write one summary into --out of these parts of one campaign (directories or summary.json)')
     a = ap.parse_args(argv)
-    if a.rescore:
+    if a.merge:
+        s = merge(a.out, a.merge, a.threshold)
+    elif a.rescore:
         s = rescore(a.out, a.threshold, not a.no_oracle)
     else:
         idx = [int(i) for i in a.indices.split(',')] if a.indices else None

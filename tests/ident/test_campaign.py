@@ -266,3 +266,32 @@ def test_resume_keeps_the_cases_of_this_code_and_refuses_another_code_or_draw(tm
         scorer.run_campaign(out, 0, SEED, indices=[2], resume=True, with_oracle=False)
     with pytest.raises(SystemExit, match=f'holds the draw of seed {SEED}, not {SEED + 1}'):
         scorer.run_campaign(out, 0, SEED + 1, indices=[2], resume=True, with_oracle=False)
+
+
+def test_merge_joins_parts_of_one_campaign_and_refuses_others(tmp_path, monkeypatch):
+    """--merge writes one summary of a campaign run in parts: a directory's cases scored again and a
+    summary.json's scored cases (a part whose case files are gone); a case in two parts, parts of two
+    codes or scored at another threshold are refused."""
+    monkeypatch.setattr(scorer, 'code_commit', lambda: 'abc1234')
+    for part, index in (('a', 2), ('b', 3)):
+        out = tmp_path / part
+        campaign.generate(out / 'cases', 0, SEED, indices=[index], duration=12.0)
+        ident = out / 'cases' / campaign.case_name(index) / 'ident'
+        ident.mkdir()
+        (ident / 'meta.json').write_text(json.dumps({'rc': 2, 'wall_s': 1.5, 'stderr_tail': ['refused'],
+                                                      'command': './ipfric identify ...', 'oracle_counts': None,
+                                                      'commit': 'abc1234'}))
+        scorer.run_campaign(out, 0, SEED, indices=[index], resume=True, with_oracle=False)
+    s = scorer.merge(tmp_path / 'all', [tmp_path / 'a', tmp_path / 'b' / 'summary.json'])
+    assert [c['case'] for c in s['cases']] == ['case0002', 'case0003']
+    assert s['meta']['seed'] == SEED and s['meta']['commit'] == 'abc1234' and s['n_cases'] == 2
+    assert '2 cases' in (tmp_path / 'all' / 'summary.md').read_text()
+    with pytest.raises(SystemExit, match='case0002 is in two parts'):
+        scorer.merge(tmp_path / 'x', [tmp_path / 'a', tmp_path / 'a' / 'summary.json'])
+    with pytest.raises(SystemExit, match='scored at 2.0 counts, not 3.0'):
+        scorer.merge(tmp_path / 'x', [tmp_path / 'b' / 'summary.json'], threshold=3.0)
+    other = json.loads((tmp_path / 'b' / 'summary.json').read_text())
+    other['meta']['commit'] = 'def5678'
+    (tmp_path / 'b' / 'summary.json').write_text(json.dumps(other))
+    with pytest.raises(SystemExit, match="codes \\['abc1234', 'def5678'\\]"):
+        scorer.merge(tmp_path / 'x', [tmp_path / 'a', tmp_path / 'b' / 'summary.json'])
