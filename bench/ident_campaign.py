@@ -189,11 +189,14 @@ def code_commit() -> str:
     return (head or 'unknown') + ('+dirty' if dirty else '')
 
 
-def identify_case(case_dir: Path, truth: dict, timeout: float = TIMEOUT) -> dict:
-    """Run ``ipfric identify`` on a case in a subprocess; its result.json (or None), wall time, exit
-    code and the last lines of its standard error."""
+def identify_case(case_dir: Path, truth: dict, timeout: float = TIMEOUT, threads: int | None = None) -> dict:
+    """Run ``ipfric identify`` on a case in a subprocess (its simulations on ``threads`` threads: by default
+    numba's own choice, every core); its result.json (or None), wall time, exit code and the last lines of
+    its standard error."""
     cmd = identify_command(case_dir, truth)
     env = dict(os.environ, OPENBLAS_NUM_THREADS='1', MKL_NUM_THREADS='1')
+    if threads is not None:
+        env['NUMBA_NUM_THREADS'] = str(threads)
     (case_dir / 'ident').mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     rc: int | str
@@ -534,8 +537,10 @@ def run_campaign(out_dir, n_cases, seed, workers=1, progress=None, threshold=THR
     returns the summary (also written to out_dir/summary.json, summary.md, detection.png).
     ``with_oracle``: also the identification's error of the true model on each case (:func:`oracle`).
     ``resume``: keep the cases already identified in ``out_dir`` by this code (:func:`done_cases`) and
-    generate and identify only the others (a campaign of hundreds of cases goes on after a stop)."""
+    generate and identify only the others (a campaign of hundreds of cases goes on after a stop). With
+    several workers each identification's simulations share the cores among them (NUMBA_NUM_THREADS)."""
     out_dir = Path(out_dir)
+    threads = max(1, (os.cpu_count() or 1) // workers) if workers > 1 else None
     case_root = out_dir / 'cases'
     indices = list(range(n_cases)) if indices is None else list(indices)
     say = progress or (lambda msg: None)
@@ -565,7 +570,7 @@ def run_campaign(out_dir, n_cases, seed, workers=1, progress=None, threshold=THR
         if code_commit() != commit:     # the tree changed under the campaign: its answers would be two codes'
             raise SystemExit(f'{name}: the code changed from {commit} to {code_commit()} during the campaign '
                              '(run it from a worktree of one commit)')
-        ident = identify_case(d, truth, timeout)
+        ident = identify_case(d, truth, timeout, threads)
         orc = oracle(d, truth) if with_oracle else None
         tmp = d / 'ident' / 'meta.json.tmp'         # written whole or not at all: a stop never leaves half a file
         tmp.write_text(json.dumps(dict({k: v for k, v in ident.items() if k != 'result'}, oracle_counts=orc,

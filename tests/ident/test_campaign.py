@@ -217,7 +217,7 @@ def fixed_cases(tmp_path_factory):
     def one(index):
         d = out / campaign.case_name(index)
         truth = json.loads((d / 'truth.json').read_text())
-        return index, (truth, scorer.identify_case(d, truth))
+        return index, (truth, scorer.identify_case(d, truth, threads=1))
     with ThreadPoolExecutor(2) as ex:
         return dict(ex.map(one, FIXED))
 
