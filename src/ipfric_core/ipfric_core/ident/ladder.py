@@ -46,6 +46,7 @@ import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
+from scipy.signal import lombscargle
 
 from ..analysis.records import Record, smooth_rate
 from ..physics.params import ConfigError
@@ -494,14 +495,19 @@ def effect_starts(pr: Problem, model: Model, name: str, prior: Model) -> list[di
     return [{}]
 
 
-#: the periods [m] :func:`ripple_starts` regresses the force balance's residual on
-RIPPLE_PERIODS = tuple(np.geomspace(0.0015, 0.03, 60))
+#: the cogging periods [m] :func:`ripple_starts` looks for (three of them at least over the travel)
+RIPPLE_RANGE = (0.0015, 0.03)
+#: its periodogram's frequencies per peak width (a peak is 1 / travel wide in 1/m: a period 2.6 % off over
+#: 20 periods of travel drifts by half a period, and a 7.7 mm cogging between a fixed grid's points 5 %
+#: apart was started at 8.4 mm)
+RIPPLE_OVERSAMPLE = 4
 
 
 def ripple_starts(rec: Record, model: Model, keep: int = 2) -> list[dict]:
     """Cogging starts from the cart's force balance (:mod:`~ipfric_core.ident.equation_error`) of
-    ``model``: its residual regressed on sin and cos(2 pi x / P) for each period of RIPPLE_PERIODS,
-    the ``keep`` periods (15 % apart at least) that explain most of it, each with its amplitudes (the
+    ``model``: its residual's periodogram over the position (Lomb-Scargle, periods of RIPPLE_RANGE, at
+    RIPPLE_OVERSAMPLE frequencies per peak width), the ``keep`` peaks (15 % apart at least) that explain
+    most of it, each with its amplitudes from the residual regressed on sin and cos(2 pi x / P) (the
     sign that lowers the balance's residual: the residual is minus the force the model lacks). From
     amplitudes of 0 the period has no gradient, and a fit from the nearest fixed period may stay at a
     small ripple of the wrong phase. Empty where the balance cannot be formed."""
@@ -516,13 +522,20 @@ def ripple_starts(rec: Record, model: Model, keep: int = 2) -> list[dict]:
     r, x = b.r[b.used], b.x[b.used]
     if len(r) < 50 or not np.any(r):
         return []
-    fits = []
-    for period in RIPPLE_PERIODS:
-        if np.ptp(x) < 3 * period:
-            continue
+
+    travel = float(np.ptp(x))
+    lo, hi = 2 * np.pi * max(1 / RIPPLE_RANGE[1], 3 / max(travel, 1e-12)), 2 * np.pi / RIPPLE_RANGE[0]
+    if lo >= hi:
+        return []
+    omega = np.arange(lo, hi, 2 * np.pi / (RIPPLE_OVERSAMPLE * travel))
+    power = lombscargle(x, r, omega)
+    peaks = [i for i in range(len(power)) if power[i] >= power[max(0, i - 1):i + 2].max()]
+
+    def explained(period: float) -> tuple[float, float, np.ndarray]:
         basis = np.column_stack([np.sin(2 * np.pi * x / period), np.cos(2 * np.pi * x / period)])
         c, *_ = np.linalg.lstsq(basis, r, rcond=None)
-        fits.append((float(np.sum((basis @ c) ** 2)), period, c))
+        return float(np.sum((basis @ c) ** 2)), period, c
+    fits = [explained(2 * np.pi / omega[i]) for i in sorted(peaks, key=lambda i: -power[i])[:4 * keep]]
     out: list[dict] = []
     for _, period, c in sorted(fits, key=lambda f: -f[0]):
         if len(out) == keep:
