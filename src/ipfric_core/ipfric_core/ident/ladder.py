@@ -498,8 +498,8 @@ def effect_starts(pr: Problem, model: Model, name: str, prior: Model) -> list[di
 #: the cogging periods [m] :func:`ripple_starts` looks for (three of them at least over the travel)
 RIPPLE_RANGE = (0.0015, 0.03)
 #: its periodogram's frequencies per peak width (a peak is 1 / travel wide in 1/m: a period 2.6 % off over
-#: 20 periods of travel drifts by half a period, and a 7.7 mm cogging between a fixed grid's points 5 %
-#: apart was started at 8.4 mm)
+#: 20 periods of travel drifts by half a period; from a fixed grid's points 5 % apart a 7.74 mm cogging
+#: was fitted at 8.41 mm)
 RIPPLE_OVERSAMPLE = 4
 
 
