@@ -451,8 +451,8 @@ def main(argv=None) -> int:
     p.add_argument('--quick', action='store_true')
     p.add_argument('--realtime-duration', type=float, default=600.0)
     p.add_argument('--campaign-cases', type=int, default=200,
-                   help='cases of the identification campaign (default 200: about three hours on two cores, one case per core; '
-                        '--quick: one)')
+                   help='cases of the identification campaign (default 200: about three hours on two cores, '
+                        'one case per core; --quick: one)')
     p.add_argument('--results', type=Path, required=True)
     p.add_argument('--json', action='store_true')
     a = p.parse_args(argv)
