@@ -41,7 +41,7 @@ from independent import campaign  # noqa: E402
 
 FRICTION_PARTS = {'coulomb', 'stribeck', 'presliding'}
 OUTSIDE = set(campaign.OUTSIDE) | {'plant_error'}
-#: declared constants the ladder tries to correct (ipfric_core.ident.ladder.PLANT_CORRECTIONS)
+#: declared constants the ladder tries to correct (ipfric_core.ident.hypotheses.PLANT_CORRECTIONS)
 CORRECTED = ('M', 'alpha')
 #: a wrong declared constant that a fitted friction parameter takes over exactly: the back-EMF beta and
 #: the viscous slope eps act as one (F = alpha V - (beta + eps) x'), so the refit explains it and no
@@ -256,8 +256,8 @@ def oracle(case_dir: Path, truth: dict, split: float = 0.6) -> dict:
     represent (a hanging pendulum read as upright, a zeros angle column taken for a pendulum)."""
     try:
         from ipfric_core.analysis.records import load
-        from ipfric_core.ident.ladder import Problem
         from ipfric_core.ident.model import load_declared
+        from ipfric_core.ident.problem import Problem
         from ipfric_core.physics.params import PlantParams
         plant = PlantParams(**truth['constants'])
         rec = load(case_dir / 'data.csv', plant, None, not truth['pendulum_attached'])

@@ -136,11 +136,12 @@ def test_a_cart_without_coulomb_friction_is_answered_by_the_viscous_law(tmp_path
 
 
 def test_a_refit_on_a_bound_has_the_leaner_laws_fitted_in_full(data):
-    """The screen of a round (``ladder.screen``) on the independent clean cart record: where the refit's
+    """The screen of a round (``hypotheses.screen``) on the independent clean cart record: where the refit's
     short fit ends with its Coulomb level on the bound 0, the viscous and Coulomb laws are fitted in full
     even when five hypotheses gained more (outside the ranks); the dynamic law, with more parts, is not;
     with the Coulomb level off its bound they are ranked as any other."""
-    from ipfric_core.ident.ladder import Problem, hypotheses, screen
+    from ipfric_core.ident.hypotheses import hypotheses, screen
+    from ipfric_core.ident.problem import Problem
     rec = load(data['cart_none'], None, cart_alone=True)
     est, _ = rec.split(0.6)
     pe = Problem(est)
@@ -159,11 +160,11 @@ def test_a_refit_on_a_bound_has_the_leaner_laws_fitted_in_full(data):
 @pytest.mark.parametrize('factor', [1.0, 0.75, 1.3])
 def test_force_balance_starts_the_mass_and_friction_from_a_wrong_declaration(data, factor):
     """The refit's and the plant corrections' starts from the cart's force balance
-    (``ladder.balance_starts``) on the independent clean cart record, the paper's cart (its mass as
+    (``starts.balance_starts``) on the independent clean cart record, the paper's cart (its mass as
     Table 1) declared ``factor`` times its mass with the paper's friction: the mass with the mass free
     within 2 %, the friction with it within 10 % (its Coulomb level, the viscous slope); with the mass
     held as declared, alpha read for the same M / alpha within 2 %."""
-    from ipfric_core.ident.ladder import balance_starts
+    from ipfric_core.ident.starts import balance_starts
     from ipfric_core.physics.params import PlantParams
     truth = rigsim.RIGS['quanser']
     rec = load(data['cart_none'], None, cart_alone=True)
@@ -183,7 +184,7 @@ def test_force_balance_starts_the_mass_and_friction_from_a_wrong_declaration(dat
 def test_the_angle_bias_starts_from_the_nearest_rest(mean, bias):
     """A hanging pendulum's angle, read from upright, averages near +/-pi: the bias starts at its offset from
     there (it started at the mean itself, -3 rad, and ended on its bound of 1 rad)."""
-    from ipfric_core.ident.ladder import rest_offset
+    from ipfric_core.ident.refutations import rest_offset
     assert rest_offset(np.array([mean - 0.05, mean + 0.05])) == pytest.approx(bias, abs=1e-12)
 
 

@@ -153,7 +153,7 @@ def lower_bound(name: str, active) -> float:
 
 def static_level(fc: float, excess: float) -> float:
     """Fs = Fc + Fs_excess [N], the static level of eq. (5): at least 0 (a static level fitted to 0 or
-    below is refuted: :func:`ipfric_core.ident.ladder.bound_params`)."""
+    below is refuted: :func:`ipfric_core.ident.refutations.bound_params`)."""
     return max(fc + excess, 0.0)
 
 

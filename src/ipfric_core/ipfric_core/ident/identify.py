@@ -22,9 +22,11 @@ from ..run.scenario import DEFAULT_SCENARIO, load_scenario
 from .effects import EFFECTS, PARAMS, static_level
 from .equation_error import base_fit, force_error, identify_steady, structure_fit
 from .held_out import INIT_SAMPLES, free_run
-from .ladder import Problem, Step, run_ladder, verdict
+from .judging import verdict
+from .ladder import Step, run_ladder
 from .ladder_report import write_ladder_report
 from .model import LAW_PARAMS, Model, declared, read_declared
+from .problem import Problem
 from .redesign import export_scenario
 
 __all__ = ['SPLIT_RANGE', 'candidate_effects', 'identify_tables', 'force_input_model', 'identify_record']

@@ -17,7 +17,9 @@ from ..analysis.records import smooth_rate  # noqa: E402
 from ..physics.friction import friction_force  # noqa: E402
 from . import shooting  # noqa: E402
 from .effects import BASE_MODELS, PARAMS, static_level  # noqa: E402
-from .ladder import PLANT_CORRECTIONS, Problem, Step  # noqa: E402
+from .hypotheses import PLANT_CORRECTIONS  # noqa: E402
+from .ladder import Step  # noqa: E402
+from .problem import Problem  # noqa: E402
 
 __all__ = ['correlation_lines', 'write_ladder_report']
 

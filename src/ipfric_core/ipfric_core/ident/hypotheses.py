@@ -1,0 +1,313 @@
+"""The hypotheses a round of the ladder tries against the current model (:class:`Hypothesis`): the
+declared law refitted, each other friction law, each plant correction and each library effect; their
+short fits, which of them are fitted in full (:func:`screen`), and their full fits.
+
+Each round, every candidate first gets a short fit (its own parameters and the friction
+levels, SCREEN_NFEV steps from each of its starts) on the cart's windows alone (the angle's
+too for an effect on the angle), on every k-th window where the estimation record holds more
+than SCREEN_SAMPLES samples per block (judged on every window: a short fit that does not carry
+over is done again on all); only the candidates whose short fit lowers the estimation error
+by at least FULL_SHARE of the best one's are fitted in full and judged (the others are
+listed with that reason and tried again next round).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from .effects import EFFECTS
+from .model import LADDER_EFFECTS, LAW_PARAMS, Model
+from .problem import SCREEN_NFEV, Problem, fit_model
+from .refutations import SIZE, bound_params, contradictions, untold
+from .starts import (
+    bristle_starts,
+    contact_damping,
+    drive_starts,
+    effect_starts,
+    law_starts,
+    peak_level,
+    stribeck_starts,
+)
+
+__all__ = ['LAWS', 'PLANT_CORRECTIONS', 'Hypothesis', 'hypotheses', 'in_place_of_mass', 'short_fit', 'short_fits',
+           'joint', 'full_fit', 'contact_held', 'errors_of', 'screen']
+
+#: the friction laws the ladder weighs against each other
+LAWS = ('viscous', 'coulomb', 'exponential', 'dynamic')
+#: the declared plant constants the ladder may correct (an effective mass with the rotor reflected, the motor's
+#: force per volt); not the back-EMF beta: it acts on the cart as the viscous slope eps does, which every law fits
+PLANT_CORRECTIONS = ('M', 'alpha')
+SCREEN_GAIN = 0.01       # an effect whose own parameters lower the estimation cost less is not refitted
+#: effects started from a grid of their error: when its best point lowers the cart's estimation cost by
+#: less than SCREEN_GAIN, they are not fitted (a drive play's simulation costs tens of ordinary ones)
+GRID_SCREENED = ('drive_backlash',)
+FULL_SHARE = 0.5         # a candidate is fitted in full when its short fit gains this share of the best one's
+FULL_TOP = 3             # and is among the best FULL_TOP of its group
+REDO_GAIN = 0.1          # a short fit that gains this much on a subset of windows and nothing on all is redone on all
+#: and one that leaves every window this much worse than the model it starts from (its friction levels
+#: wandered off on the subset)
+REDO_LOSS = 0.1
+
+
+#: the lightest motor side of a drive with play the ladder fits [share of the cart's mass]
+MIN_DRIVE_SHARE = 0.02
+
+
+@dataclass
+class Hypothesis:
+    """One explanation of what the current model misses: a model with some parameters to fit.
+
+    kind : 'friction' (the declared law refitted), 'law' (another friction law), 'plant' (a declared
+        constant corrected: the effective mass with the rotor reflected, the motor's alpha or beta) or
+        'effect' (one of the library's, with the friction levels refitted beside it or, on the declared
+        friction, alone)
+    own : the parameters that are the hypothesis (checked: bounds, size, relevance)
+    free : the parameters its short fit moves (own, and the friction levels where they may move)
+    """
+
+    label: str
+    kind: str
+    model: Model
+    own: tuple
+    free: tuple
+    starts: list = field(default_factory=lambda: [{}])
+    effect: str | None = None
+    #: an effect of GRID_SCREENED: not fitted when the best of its starts explains nothing (False where its
+    #: starts already explain what the current model does: a drive in place of a mass correction)
+    screened: bool = True
+
+
+def hypotheses(pe: Problem, current: Model, declared: Model, allowed=None, balance: dict | None = None
+               ) -> list[Hypothesis]:
+    """The explanations a round tries against ``current`` (see :class:`Hypothesis`): the declared law
+    refitted (until it is), each other law, each plant correction not made yet, each library effect not
+    added (``allowed`` restricts them), with the friction levels refitted and, before any refit, also
+    on the declared friction alone. ``balance``: further starts of the refit and the plant corrections
+    (:func:`balance_starts`). A law refitted with some of its levels held (:func:`full_fit`) counts as
+    refitted, and the held ones stay held: the data did not determine them."""
+    rec = pe.rec
+    law = LAW_PARAMS[current.law]
+    refitted = any(current.param(n).free for n in law)
+    levels = tuple(n for n in ('Fc', 'Fs_excess') if n in law and (current.param(n).free or not refitted))
+    balance = balance or {}
+    out = []
+    if not refitted:
+        out.append(Hypothesis('refit', 'friction', current.with_free(law), law, law,
+                              [{}] + stribeck_starts(current) + ([balance['refit']] if 'refit' in balance else [])))
+    for other in LAWS:
+        if other != current.law:
+            m = current.with_law(other, law_starts(declared))
+            if other == 'dynamic':      # bristles stiffer than a tenth of a count of presliding are not seen
+                m = m.with_bounds('sigma0', 0.0, 10 * peak_level(m) / rec.x_resolution)
+            out.append(Hypothesis(f'law {other}', 'law', m, LAW_PARAMS[other], LAW_PARAMS[other],
+                                  bristle_starts(m) if other == 'dynamic' else [{}] + stribeck_starts(m)))
+    for name in PLANT_CORRECTIONS:
+        if not current.param(name).free:
+            out.append(Hypothesis(f'{name} corrected', 'plant', current.with_free((name,) + law), (name,),
+                                  (name,) + law, [{}] + ([balance[name]] if name in balance else [])))
+    for name in LADDER_EFFECTS:
+        if name in current.effects or (allowed is not None and name not in allowed):
+            continue
+        if EFFECTS[name].needs_theta and rec.theta is None:
+            continue
+        own = EFFECTS[name].params
+        starts = effect_starts(pe, current, name, declared)
+        base = current.with_effect(name)
+        if name == 'drive_backlash':   # a motor side lighter than this is no drive (and its contact rings at kHz)
+            base = base.with_bounds('drive_mass_kg', MIN_DRIVE_SHARE * current['M'], math.inf)
+        out.append(Hypothesis(name, 'effect', base.with_free(levels), own, own + levels, starts, name))
+        if name == 'drive_backlash' and current.param('M').free and current['M'] > declared['M']:
+            out.append(in_place_of_mass(pe, current, declared, levels))
+        if not refitted:
+            out.append(Hypothesis(f'{name} on the declared friction', 'effect', base, own, own, starts, name))
+    return out
+
+
+#: the plays [m] of a drive in place of a mass correction (a play the mass explained is a small one)
+IN_PLACE_GAPS = (1e-4, 3e-4, 1e-3)
+
+
+def in_place_of_mass(pe: Problem, current: Model, declared: Model, levels: tuple) -> Hypothesis:
+    """A drive with play in place of a mass correction: the cart's mass as declared again, the mass the
+    correction added on the drive's motor side (a rotor and gears reflected to the rack move with the
+    cart while the play is closed: a heavier cart, until the drive reverses), the friction as fitted
+    with the correction; its starts from :func:`drive_starts` with that motor side."""
+    name = 'drive_backlash'
+    base = current.holding({'M': declared['M']}).with_effect(name)
+    base = base.with_bounds('drive_mass_kg', MIN_DRIVE_SHARE * declared['M'], math.inf)
+    extra = current['M'] - declared['M']
+    starts = drive_starts(pe, base, current, masses=[extra], gaps=IN_PLACE_GAPS)
+    own = EFFECTS[name].params
+    return Hypothesis(f'{name} in place of M corrected', 'effect', base.with_free(levels), own, own + levels,
+                      starts, name, screened=False)
+
+
+def short_fit(pe: Problem, current: Model, h: Hypothesis, prior: Model, ps: Problem) -> tuple[Model, float]:
+    """The best short fit of hypothesis ``h`` over its starts (SCREEN_NFEV steps each, its ``free``
+    parameters) on the cart's windows of ``ps`` (:meth:`Problem.screen`; the angle's too for an effect on
+    the angle), and the share by which it lowers the estimation error of every window of ``pe`` (0 for a
+    drive play whose best grid point explains nothing: not fitted). Where the subset's fit does not
+    carry over to every window (it gains REDO_GAIN on the subset, less than SCREEN_GAIN on all, or it
+    leaves all REDO_LOSS worse than ``current``: its friction levels wandered off on the subset), the
+    fits are done again on ``pe``; on the subset, the gain is counted from the friction levels refitted
+    there alone (:meth:`Problem.baseline`), not from ``current``."""
+    starts = [h.model.with_values(s) for s in h.starts]
+    if h.effect in GRID_SCREENED and h.screened:
+        costs = [ps.cart_cost(m) for m in starts]
+        if min(costs) > (1 - SCREEN_GAIN) * ps.cart_cost(current):
+            return starts[int(np.argmin(costs))], 0.0   # the best of a grid explains nothing: not fitted
+    levels = set(h.free) - set(h.own)
+    on_angle = h.effect is not None and EFFECTS[h.effect].needs_theta
+
+    def fit(pr):
+        pr = pr if on_angle else pr.cart()
+        fits = [fit_model(pr, m, max_nfev=SCREEN_NFEV, only=set(h.free), prior=prior, errors=False)[0]
+                for m in starts]
+        best = fits[int(np.argmin([pr.cost(m) for m in fits]))]
+        return best, 1.0 - pr.cost(best) / pr.cost(pr.baseline(current, levels, prior))
+    best, gain = fit(ps)
+    full = 1.0 - pe.cost(best) / pe.cost(current)
+    if ps is not pe and full < SCREEN_GAIN and (gain >= REDO_GAIN or full < -REDO_LOSS):
+        best, _ = fit(pe)
+        full = 1.0 - pe.cost(best) / pe.cost(current)
+    return best, full
+
+
+def short_fits(pe: Problem, current: Model, hs: list[Hypothesis], prior: Model, ps: Problem
+               ) -> list[tuple[Model, float]]:
+    """:func:`short_fit` of every hypothesis of a round, the refit's first: each effect that refits the
+    friction levels beside its own parameters then starts from the whole law as the refit's short fit
+    left it, and fits the law with its own parameters in full. From the declared friction, a short fit of
+    the levels alone could not reach what the refit reaches by the viscous slope and the Stribeck
+    velocity too, and every such effect lost to the refit, or to a plant correction that took the refit
+    with it (a delay of a sixth of a sample answered by alpha 0.8 % low). A plant correction, which
+    refits the whole law itself, starts from both: a refit without it may have bent the friction to
+    make up for a wrong mass (a motor side that moves with the cart: the viscous slope sank to 0)."""
+    out: dict[int, tuple[Model, float]] = {i: short_fit(pe, current, h, prior, ps)
+                                           for i, h in enumerate(hs) if h.kind == 'friction'}
+    seed = {}
+    if out:
+        refit = next(iter(out.values()))[0]
+        law = LAW_PARAMS[refit.law]
+        seed = {n: refit[n] for n in law}
+    for i, h in enumerate(hs):
+        if i in out:
+            continue
+        if seed and h.kind == 'effect' and set(h.free) - set(h.own):
+            h = replace(h, model=h.model.with_free(law), starts=[{**seed, **st} for st in h.starts])
+        elif seed and h.kind == 'plant':
+            h = replace(h, starts=h.starts + [seed])
+        hs[i] = h
+        out[i] = short_fit(pe, current, h, prior, ps)
+    return [out[i] for i in range(len(hs))]
+
+
+def joint(h: Hypothesis, model: Model) -> set:
+    """The parameters a hypothesis's full fit moves: its own and those the model already fits (its
+    friction law's among them)."""
+    return set(h.free) | {p.name for p in model.free}
+
+
+def full_fit(pe: Problem, h: Hypothesis, best: Model, prior: Model) -> tuple[Model, dict]:
+    """The fit of the hypothesis's parameters with every parameter the model already fits (:func:`joint`),
+    from its short fit ``best``. A refit of the declared law that puts one of its levels on a bound is done
+    again with that level held at its declared value, and any hypothesis that fits the Coulomb level and
+    ends with it within two standard errors of zero (:func:`untold`) with it held at its value in the
+    hypothesis's start model (the declared one, or the one an earlier round fitted): the data did not
+    determine it (below the Stribeck velocity the Coulomb level and the curve's width trade; a balancing
+    loop's cart seldom stops), and neither a bound nor a cart without Coulomb friction is an answer (an
+    amplifier clipping at 2.7 V that explained a balancing loop to its floor was refused for an Fc of
+    0.07 +/- 0.13 N). Returns the model and its standard errors where that test computed them at it (else
+    {}: :func:`confirm` computes them)."""
+    m = fit_model(pe, best, only=joint(h, best), prior=prior, errors=False)[0]
+    contact = contact_held(m)
+    if contact:
+        m = fit_model(pe, m.holding(contact), only=joint(h, best) - set(contact), prior=prior, errors=False)[0]
+    fits_fc = 'Fc' in {p.name for p in m.free}
+    if h.kind != 'friction' and not fits_fc:
+        return m, {}
+    held: dict = dict(contact)
+    std: dict = {}
+    for _ in LAW_PARAMS[m.law]:      # a level held, another may go to its bound: until none does
+        new = {p.name: prior[p.name] for p in bound_params(m)
+               if h.kind == 'friction' and p.name in LAW_PARAMS[m.law]}
+        if not new and fits_fc and 'Fc' not in held:
+            std = errors_of(pe, h, m, prior)
+            if untold(m, std):
+                new = {'Fc': h.model['Fc']}
+        if not new:
+            break
+        held.update(new)
+        std = {}
+        m = fit_model(pe, m.holding(held), only=joint(h, best) - set(held), prior=prior, errors=False)[0]
+    return m, std
+
+
+def contact_held(model: Model) -> dict:
+    """The damping of a drive's contact where a fit put it on a bound, at the damping ratio of
+    :data:`DRIVE_GRID` for the fitted stiffness and masses: a stiff contact rings for a few milliseconds
+    at each knock, too briefly for the encoder to tell its damping (the play, the motor side and the
+    friction, which the data do fix, are fitted again with it held there)."""
+    p = model.param('drive_damping_Ns_per_m') if 'drive_backlash' in model.effects else None
+    if p is None or not p.free or p not in bound_params(model):
+        return {}
+    return {p.name: contact_damping(model['drive_stiffness_N_per_m'], model['drive_mass_kg'], model['M'])}
+
+
+def errors_of(pe: Problem, h: Hypothesis, model: Model, prior: Model) -> dict:
+    """The standard errors of a fitted hypothesis's parameters at its fit (no step taken: the Jacobian
+    there, checked along each parameter of its own; :func:`fit_model`)."""
+    return fit_model(pe, model, max_nfev=0, only=joint(h, model), prior=prior,
+                     profile=set(SIZE.get(h.effect or '', ())) | set(h.own))[1]
+
+
+def screen(hs: list[Hypothesis], short: list[tuple[Model, float]], pe: Problem, current: Model
+           ) -> list[str | None]:
+    """Which hypotheses are fitted in full this round: per hypothesis None, or why not. An effect with the
+    friction levels free is measured by what it adds to the refit's short fit (the refit's gain it takes
+    for free); the others by their gain over ``current``. A short fit the data already contradict
+    (:func:`contradictions`) is refused here and takes no place in its group. A hypothesis is fitted in
+    full when its gain reaches SCREEN_GAIN and FULL_SHARE of the best of its group's, and it is among the
+    FULL_TOP best of it. Fitted in full whenever they reach SCREEN_GAIN, outside the ranks: the refit of the
+    declared law (the hypotheses that carry it must beat it: :func:`beyond_refit`; screened out by rank, it
+    left a balancing loop with nothing kept where it alone explained 37 % of the validation error), and the
+    leaner laws where the refit's short fit ends on a bound (the declared law is refuted there, and a law
+    with more parts ends on the same bound: a cart logged at 30 ms whose refit lost its Coulomb level kept
+    nothing, the viscous law ranked fourth)."""
+    refit = next((m for h, (m, _) in zip(hs, short) if h.kind == 'friction'), None)
+    base = pe.cost(refit) if refit is not None else None
+    refuted_law = refit is not None and any(p.name in LAW_PARAMS[refit.law] for p in bound_params(refit))
+    gains = []
+    refuted = []
+    forced = []
+    for h, (m, g) in zip(hs, short):
+        levels = bool(set(h.free) - set(h.own)) and h.kind == 'effect'
+        gains.append((levels, 1.0 - pe.cost(m) / base if levels and base else g))
+        why = contradictions(pe, m, h.effect) if h.effect and g >= SCREEN_GAIN else []
+        refuted.append('its short fit: ' + '; '.join(why) if why else None)
+        leaner = h.kind == 'law' and len(h.own) < len(LAW_PARAMS[current.law])
+        forced.append(g >= SCREEN_GAIN and (h.kind == 'friction' or (leaner and refuted_law)))
+    alive = [(lv, g) for (lv, g), r, f in zip(gains, refuted, forced) if r is None and not f]
+    top = {grp: max([g for lv, g in alive if lv == grp], default=0.0) for grp in (True, False)}
+    rank = {grp: sorted((g for lv, g in alive if lv == grp), reverse=True) for grp in (True, False)}
+    out: list[str | None] = []
+    for (lv, g), r, f in zip(gains, refuted, forced):
+        what = 'beyond the refit\'s' if lv else 'over the model\'s'
+        if r is not None:
+            out.append(r)
+        elif f:
+            out.append(None)
+        elif g < SCREEN_GAIN:
+            out.append(f'its short fit lowers the estimation error by {100 * g:.2g} % {what} only')
+        elif g < FULL_SHARE * top[lv]:
+            out.append(f'its short fit lowers the estimation error by {100 * g:.2g} % {what}, less than '
+                       f'{100 * FULL_SHARE:g} % of the best one\'s {100 * top[lv]:.2g} %: not fitted in full '
+                       f'this round')
+        elif rank[lv].index(g) >= FULL_TOP:
+            out.append(f'its short fit lowers the estimation error by {100 * g:.2g} % {what}: not among the '
+                       f'{FULL_TOP} best of its group, not fitted in full this round')
+        else:
+            out.append(None)
+    return out

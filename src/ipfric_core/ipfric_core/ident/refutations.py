@@ -1,0 +1,222 @@
+"""What refutes a fitted model besides its simulation error: what the record itself shows (its
+breakaways from rest, steady speeds, the lag of its response, a drive's crossings of its play, its rest
+angle) and contradicts, a parameter that ends on a bound of its range, and a size, a Coulomb level or a
+plant correction not told from zero or from the value it corrects."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..analysis.records import Record, smooth_rate
+from . import shooting
+from .effects import PARAMS, static_level
+from .model import Model
+from .problem import Problem
+
+__all__ = ['SIZE', 'stops_and_starts', 'smallest_moving_command', 'steady_speeds', 'response_lag', 'drive_crossings',
+           'contradictions', 'unresolved', 'near', 'uncorrected', 'rest_offset', 'no_static_level', 'bound_params',
+           'on_bounds', 'untold']
+
+UNDO_SIGMA = 2.0         # a correction that ends this many standard errors from the declared value or closer is undone
+STOP_S = 0.05            # a stretch this long with the encoder still is a stop [s]
+
+
+def stops_and_starts(rec: Record) -> list[tuple[int, int]]:
+    """(last still sample, first moving sample) of every breakaway after a stop of STOP_S."""
+    x, t = rec.x, rec.t
+    moves = np.flatnonzero(np.diff(x) != 0.0)
+    out = []
+    for a, b in zip(moves[:-1], moves[1:]):
+        if t[b] - t[a + 1] >= STOP_S:
+            out.append((int(b), int(b) + 1))
+    return out
+
+
+def smallest_moving_command(rec: Record) -> float | None:
+    """The command that moved the cart from rest [V]: the largest |command| over the 5 ms before
+    each breakaway, its 10th percentile over the breakaways. A deadzone must be below it (a
+    larger one would have kept the cart still). None with a pendulum attached: its swing moves the
+    cart with no command at all."""
+    if rec.theta is not None:
+        return None
+    vals = []
+    for still, _ in stops_and_starts(rec):
+        lo = np.searchsorted(rec.t, rec.t[still] - 0.005)
+        vals.append(float(np.max(np.abs(rec.u[lo:still + 1]))))
+    return float(np.quantile(vals, 0.1)) if len(vals) >= 3 else None
+
+
+def steady_speeds(rec: Record, hold_s: float = 0.3) -> list[tuple[float, float]]:
+    """(|command| [V], |speed| [m/s]) at the end of every stretch the command stayed constant
+    for ``hold_s``: a saturation at u_max is refuted by speeds still growing above it."""
+    u, t = rec.u, rec.t
+    change = np.flatnonzero(np.diff(u) != 0.0)
+    bounds = np.concatenate([[0], change + 1, [len(u)]])
+    out = []
+    for a, b in zip(bounds[:-1], bounds[1:]):
+        if t[b - 1] - t[a] >= hold_s and u[a] != 0.0:
+            k = np.searchsorted(t, t[b - 1] - 0.1)
+            if b - 1 > k:
+                out.append((abs(float(u[a])), abs(float((rec.x[b - 1] - rec.x[k]) / (t[b - 1] - t[k])))))
+    return out
+
+
+def response_lag(rec: Record, max_lag: float = 0.1) -> float:
+    """Lag [s] at which changes of the cart's acceleration follow changes of the command best (a
+    step of the force is a step of the acceleration): a transport delay longer than it (plus
+    two samples) is not in the data."""
+    v = smooth_rate(rec.t, rec.x, rec.valid_mask, shooting.FILTER_HZ)
+    du, da = np.diff(rec.u), np.diff(np.gradient(v, rec.t))
+    n = int(max_lag / rec.dt)
+    cc = [float(np.dot(du[:len(du) - k], da[k:])) for k in range(n)]
+    return int(np.argmax(cc)) * rec.dt
+
+
+def drive_crossings(pr: Problem, model: Model) -> np.ndarray:
+    """Durations [s] of the model's motor side crossing its whole play (from contact on one side
+    to contact on the other: a reversal of the drive force), run along ``pr``'s record
+    (:func:`shooting.drive_states`)."""
+    rec, vec = pr.rec, model.vectors()
+    drive = vec.truth.drive_vector()
+    side = shooting.drive_states(vec.pp, drive[0], drive[1], rec.t, shooting.applied_commands(vec, rec),
+                                 pr.blocks[0][1].motion)[:, 2]
+    touch = np.flatnonzero(side != 0.0)
+    if len(touch) < 2:
+        return np.zeros(0)
+    before, after = touch[:-1], touch[1:]
+    across = side[before] != side[after]
+    return rec.t[after[across]] - rec.t[before[across]]
+
+
+def contradictions(pr: Problem, model: Model, name: str) -> list[str]:
+    """Why the data refute the fitted effect ``name`` (empty when nothing does)."""
+    rec = pr.rec
+    why: list[str] = []
+    if name == 'deadzone':
+        low = smallest_moving_command(rec)
+        if low is not None and model['deadzone_V'] >= low:
+            why.append(f'deadzone {model["deadzone_V"]:.3g} V is not below {low:.3g} V, a command that moved the cart')
+    if name == 'saturation':
+        share = float(np.mean(np.abs(rec.u) > model['saturation_V']))
+        if share < 0.01:
+            why.append(f'saturation at {model["saturation_V"]:.3g} V clips {100 * share:.2g} % of the commands '
+                       f'(needs 1 %)')
+        above = sorted((u, s) for u, s in steady_speeds(rec) if u > model['saturation_V'])
+        if len(above) >= 2 and above[-1][1] > 1.05 * above[0][1] and above[-1][0] > 1.05 * above[0][0]:
+            why.append(f'saturation at {model["saturation_V"]:.3g} V, but the steady speed still grew from '
+                       f'{above[0][1]:.3g} m/s at {above[0][0]:.3g} V to {above[-1][1]:.3g} m/s '
+                       f'at {above[-1][0]:.3g} V')
+    if name == 'delay':
+        lag = response_lag(rec)
+        if model['input_delay_s'] > lag + 2 * rec.dt:
+            why.append(f'delay {model["input_delay_s"] * 1e3:.3g} ms exceeds the lag at which the cart answers the '
+                       f'command ({lag * 1e3:.3g} ms)')
+    if name == 'cogging' and np.ptp(rec.x) < 3 * model['cogging_period_m']:
+        why.append(f'cogging period {model["cogging_period_m"] * 1e3:.3g} mm: fewer than 3 periods over the travel '
+                   f'({np.ptp(rec.x) * 1e3:.3g} mm)')
+    if name == 'backlash' and model['backlash_m'] < 2 * rec.x_resolution:
+        why.append(f'play {model["backlash_m"] * 1e3:.3g} mm is below two encoder counts (quantization)')
+    if name == 'drive_backlash':
+        if model['drive_backlash_m'] < 2 * rec.x_resolution:
+            why.append(f'drive play {model["drive_backlash_m"] * 1e3:.3g} mm is below two encoder counts '
+                       f'(quantization)')
+        crossings = drive_crossings(pr, model)
+        if len(crossings) < 3:
+            why.append(f'the motor side crosses its play at {len(crossings)} reversals of the drive force '
+                       f'(needs 3)')
+        elif np.median(crossings) < 2 * rec.dt:
+            why.append(f'the motor side crosses its play in {np.median(crossings) * 1e3:.3g} ms (median over '
+                       f'{len(crossings)} reversals), under two samples: the data cannot show it')
+    return why
+
+
+#: the parameters that give an effect its size (zero = no effect)
+SIZE = {'deadzone': ('deadzone_V',), 'delay': ('input_delay_s',), 'cogging': ('cogging_sin_N', 'cogging_cos_N'),
+        'asymmetry': ('asymmetry', 'asymmetry_viscous_Ns_per_m'), 'offset': ('offset_N',),
+        'sensor_bias': ('bias_theta_rad',), 'backlash': ('backlash_m',), 'drive_backlash': ('drive_backlash_m',)}
+
+
+def unresolved(model: Model, std: dict, name: str) -> list[str]:
+    """The effect's size is not told from zero: every size parameter within two standard errors."""
+    stds = [std.get(k) for k in SIZE.get(name, ())]
+    if not stds:
+        return []
+    if any(s is None or not math.isfinite(s) for s in stds):
+        return ['its size has no standard error (the data do not determine it)']
+    sizes = [(k, model[k], float(s or 0.0)) for k, s in zip(SIZE[name], stds)]
+    if all(abs(v) <= 2 * s for _, v, s in sizes):
+        return ['its size is within two standard errors of zero (' +
+                ', '.join(f'{k} = {v:.3g} +/- {s:.2g}' for k, v, s in sizes) + ')']
+    return []
+
+
+def near(value: float, ref: float, s) -> bool:
+    """``value`` within UNDO_SIGMA standard errors ``s`` of ``ref`` (a correction not told from the value it
+    corrects); False where ``s`` is missing or not finite."""
+    return s is not None and math.isfinite(s) and abs(value - ref) <= UNDO_SIGMA * s
+
+
+def uncorrected(model: Model, std: dict, before: Model, names) -> list[str]:
+    """A plant correction not told from the value it corrects (``before``'s: :func:`near`), or without a
+    standard error (alpha 0.1 % low, 1.5 standard errors, kept on a clean cart for 0.06 count)."""
+    out = []
+    for n in names:
+        s = std.get(n)
+        if s is None or not math.isfinite(s):
+            out.append(f'{n} has no standard error (the data do not determine it)')
+        elif near(model[n], before[n], s):
+            out.append(f'{n} = {model[n]:.4g} +/- {s:.2g} {model.param(n).unit} is within {UNDO_SIGMA:g} standard '
+                       f'errors of {before[n]:.4g}: not told from it')
+    return out
+
+
+def rest_offset(theta: np.ndarray) -> float:
+    """The mean angle's offset [rad] from the equilibrium nearest to it (upright 0, hanging +/-pi): where a
+    biased angle encoder puts a pendulum at rest (a hanging one's mean is near -pi, not a bias of -3 rad
+    against the bias's bound of 1 rad)."""
+    mean = float(np.mean(theta))
+    return mean - math.pi * round(mean / math.pi)
+
+
+#: parameters whose lower bound is the simpler law itself, not a limit of physics: in the coulomb law,
+#: static friction no higher than the Coulomb level is Coulomb friction without stiction (the data saw no
+#: sticking); the laws with a Stribeck curve take a static level below it (a friction that rises with speed)
+NESTED_AT_LOWER = ('Fs_excess',)
+
+
+def no_static_level(model: Model, p) -> bool:
+    """True when ``p`` is Fs_excess and puts the static level Fc + Fs_excess at 0 or below (no static
+    friction at all: :func:`~ipfric_core.ident.effects.static_level`)."""
+    return p.name == 'Fs_excess' and static_level(model['Fc'], p.value) <= 1e-3 * PARAMS[p.name].typical
+
+
+def bound_params(model: Model) -> list:
+    """The fitted parameters of ``model`` that end on a bound of their range; but for
+    :data:`NESTED_AT_LOWER` at their lower one; Fs_excess also where :func:`no_static_level`."""
+    def refutes(p) -> bool:
+        tol = 1e-3 * PARAMS[p.name].typical
+        if no_static_level(model, p):
+            return True
+        return p.at_bound(tol) and not (p.name in NESTED_AT_LOWER and p.value - p.lo <= tol)
+    return [p for p in model.free if refutes(p)]
+
+
+def on_bounds(model: Model) -> list[str]:
+    """Why a fitted parameter of ``model`` refutes it: it ends on a bound of its range (a bound reached
+    means the law or the effect is refuted there; :func:`bound_params`)."""
+    def bound(p) -> str:
+        if no_static_level(model, p):
+            return f'-Fc = {-model["Fc"]:.4g} N: no static friction'
+        return f'[{p.lo:g}, {p.hi:g}]'
+    return [f'{p.name} = {p.value:.4g} {p.unit} ends on its bound {bound(p)}' for p in bound_params(model)]
+
+
+def untold(model: Model, std: dict) -> list[str]:
+    """A friction level that is not told from zero refutes the model: a real cart slides against a
+    Coulomb level (Fc within two standard errors of 0 means the model makes up for something else)."""
+    s = std.get('Fc')
+    if 'Fc' in {p.name for p in model.free} and s is not None and math.isfinite(s) and model['Fc'] <= 2 * s:
+        return [f'Fc = {model["Fc"]:.3g} +/- {s:.2g} N is not told from zero: a real cart slides against a '
+                f'Coulomb level; the model makes up for something else']
+    return []
