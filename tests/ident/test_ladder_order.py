@@ -9,7 +9,7 @@ from ipfric_core.ident import judging
 
 def judged(name, n_free, score):
     model = SimpleNamespace(name=name, free=[object()] * n_free)
-    return judging.Judged(SimpleNamespace(label=name), model, {}, 0.0, 0.0, score, [])
+    return judging.Judged(SimpleNamespace(label=name), model, 0.0, 0.0, score, [])
 
 
 @pytest.fixture

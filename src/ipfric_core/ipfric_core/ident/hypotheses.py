@@ -210,7 +210,7 @@ def joint(h: Hypothesis, model: Model) -> set:
     return set(h.free) | {p.name for p in model.free}
 
 
-def full_fit(pe: Problem, h: Hypothesis, best: Model, prior: Model) -> tuple[Model, dict]:
+def full_fit(pe: Problem, h: Hypothesis, best: Model, prior: Model) -> Model:
     """The fit of the hypothesis's parameters with every parameter the model already fits (:func:`joint`),
     from its short fit ``best``. A refit of the declared law that puts one of its levels on a bound is done
     again with that level held at its declared value, and any hypothesis that fits the Coulomb level and
@@ -219,30 +219,27 @@ def full_fit(pe: Problem, h: Hypothesis, best: Model, prior: Model) -> tuple[Mod
     determine it (below the Stribeck velocity the Coulomb level and the curve's width trade; a balancing
     loop's cart seldom stops), and neither a bound nor a cart without Coulomb friction is an answer (an
     amplifier clipping at 2.7 V that explained a balancing loop to its floor was refused for an Fc of
-    0.07 +/- 0.13 N). Returns the model and its standard errors where that test computed them at it (else
-    {}: :func:`confirm` computes them)."""
+    0.07 +/- 0.13 N). That test checks the Coulomb level's error alone (:func:`errors_of` ``among``): the
+    others are computed for the hypotheses that pass (:func:`~ipfric_core.ident.ladder.confirm`)."""
     m = fit_model(pe, best, only=joint(h, best), prior=prior, errors=False)[0]
     contact = contact_held(m)
     if contact:
         m = fit_model(pe, m.holding(contact), only=joint(h, best) - set(contact), prior=prior, errors=False)[0]
     fits_fc = 'Fc' in {p.name for p in m.free}
     if h.kind != 'friction' and not fits_fc:
-        return m, {}
+        return m
     held: dict = dict(contact)
-    std: dict = {}
     for _ in LAW_PARAMS[m.law]:      # a level held, another may go to its bound: until none does
         new = {p.name: prior[p.name] for p in bound_params(m)
                if h.kind == 'friction' and p.name in LAW_PARAMS[m.law]}
         if not new and fits_fc and 'Fc' not in held:
-            std = errors_of(pe, h, m, prior)
-            if untold(m, std):
+            if untold(m, errors_of(pe, h, m, prior, among={'Fc'})):
                 new = {'Fc': h.model['Fc']}
         if not new:
             break
         held.update(new)
-        std = {}
         m = fit_model(pe, m.holding(held), only=joint(h, best) - set(held), prior=prior, errors=False)[0]
-    return m, std
+    return m
 
 
 def contact_held(model: Model) -> dict:
@@ -256,11 +253,12 @@ def contact_held(model: Model) -> dict:
     return {p.name: contact_damping(model['drive_stiffness_N_per_m'], model['drive_mass_kg'], model['M'])}
 
 
-def errors_of(pe: Problem, h: Hypothesis, model: Model, prior: Model) -> dict:
+def errors_of(pe: Problem, h: Hypothesis, model: Model, prior: Model, among=None) -> dict:
     """The standard errors of a fitted hypothesis's parameters at its fit (no step taken: the Jacobian
-    there, checked along each parameter of its own; :func:`fit_model`)."""
+    there, checked along each parameter of its own, or of those of them in ``among``; :func:`fit_model`)."""
+    profile = set(SIZE.get(h.effect or '', ())) | set(h.own)
     return fit_model(pe, model, max_nfev=0, only=joint(h, model), prior=prior,
-                     profile=set(SIZE.get(h.effect or '', ())) | set(h.own))[1]
+                     profile=profile if among is None else profile & set(among))[1]
 
 
 def screen(hs: list[Hypothesis], short: list[tuple[Model, float]], pe: Problem, current: Model

@@ -14,7 +14,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -61,20 +61,19 @@ class Judged:
 
     h: Hypothesis
     model: Model
-    std: dict
     gain: float            # validation error drop [%]
     p_value: float
     score: float           # validation cost with the per-parameter penalty (lower is better)
     refused: list
+    std: dict = field(default_factory=dict)   # its standard errors, once it passes (ladder.confirm)
 
 
-def judge(pe: Problem, pv: Problem, current: Model, h: Hypothesis, m: Model, note: str | None, sse0_v,
-          std: dict) -> Judged:
+def judge(pe: Problem, pv: Problem, current: Model, h: Hypothesis, m: Model, note: str | None, sse0_v
+          ) -> Judged:
     """The checks of a fitted hypothesis that need no standard errors (module docstring); its score is
     the validation mean squared error times exp(2 k / n), k its fitted parameters and n the validation
     windows (the per-parameter penalty of an information criterion with the windows as the independent
-    samples). ``note``: why it was not fitted in full (then it is refused); ``std``: its standard errors where
-    :func:`full_fit` computed them (else {})."""
+    samples). ``note``: why it was not fitted in full (then it is refused)."""
     ev1 = pv.cost(m)
     ee0, ee1 = pe.cost(current), pe.cost(m)
     gain, pval, dropped = drop_checks(pv, current, m, sse0_v)
@@ -89,7 +88,7 @@ def judge(pe: Problem, pv: Problem, current: Model, h: Hypothesis, m: Model, not
         if key in before and after[key] > max(before[key] * (1 + WORSE_PERCENT / 100), before[key] + WORSE_COUNTS):
             why.append(f'validation {key.split("_")[0]} error rises from {before[key]:.3g} to {after[key]:.3g} counts')
     k = len(m.free)
-    return Judged(h, m, std, gain, pval, ev1 * math.exp(2 * k / max(pv.n_windows, 1)), why)
+    return Judged(h, m, gain, pval, ev1 * math.exp(2 * k / max(pv.n_windows, 1)), why)
 
 
 def drop_checks(pv: Problem, before: Model, m: Model, sse0_v) -> tuple[float, float, list[str]]:

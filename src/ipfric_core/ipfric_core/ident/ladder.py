@@ -45,7 +45,7 @@ def confirm(pe: Problem, pv: Problem, current: Model, j: Judged, prior: Model) -
     """The checks of a hypothesis that passed :func:`judge` which need its standard errors (its size told
     from zero, a plant correction told from the value it corrects, a Coulomb level told from zero) and its
     contribution to the simulated motion; the reasons it fails them are added to ``j.refused``."""
-    j.std = j.std or errors_of(pe, j.h, j.model, prior)
+    j.std = errors_of(pe, j.h, j.model, prior)
     why = untold(j.model, j.std) + (unresolved(j.model, j.std, j.h.effect) if j.h.effect else [])
     if j.h.kind == 'plant':
         why += uncorrected(j.model, j.std, current, j.h.own)
@@ -132,8 +132,8 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
         notes = screen(hs, short, pe, current)
         judged = []
         for h, (m, _), note in zip(hs, short, notes):
-            m, std = full_fit(pe, h, m, declared) if note is None else (m, {})
-            judged.append(judge(pe, pv, current, h, m, note, sse0_v, std))
+            m = full_fit(pe, h, m, declared) if note is None else m
+            judged.append(judge(pe, pv, current, h, m, note, sse0_v))
         beyond_refit(pv, current, judged)
         passing = leaner_first(sorted((j for j in judged if not j.refused), key=lambda j: j.score), pv)
         ok = []
