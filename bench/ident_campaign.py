@@ -63,8 +63,10 @@ def components(truth: dict, threshold: float = THRESHOLD) -> list[dict]:
     """Every undeclared discrepancy of a case: effects and a wrong declared constant. A two-mass drive
     whose play alone (truth ``play_contribution_counts_rms``: the drive against its motor side fixed to
     the cart) stays below ``threshold`` is a cart heavier by the motor side's mass: ``M corrected``. A
-    deadzone counts by what it does beyond a Coulomb level higher by alpha dz (truth
-    ``beyond_friction_counts_rms``): the friction every identification refits takes that part over."""
+    deadzone counts by what neither of the models without it takes over: the smaller of its whole contribution
+    and what it does beyond a Coulomb level higher by alpha dz (truth ``beyond_friction_counts_rms``: the
+    friction every identification refits takes that part over; in a closed loop the shifted level can move
+    the motion more than the deadzone itself, and the model without it is then the nearer one)."""
     out = []
     for k, v in truth['effects'].items():
         comp = dict(name=k, library=bool(v['library']), counts=float(v['contribution_counts_rms']))
@@ -74,8 +76,9 @@ def components(truth: dict, threshold: float = THRESHOLD) -> list[dict]:
                         f'({v["motor_mass_kg"]:.3g} kg) moves with the cart')
         beyond = v.get('beyond_friction_counts_rms')
         if k == 'deadzone' and beyond is not None:
-            comp.update(counts=float(beyond), detail=f'{comp["counts"]:.3g} counts, {beyond:.3g} of them beyond a '
-                        'Coulomb level higher by alpha dz')
+            comp.update(counts=min(comp['counts'], float(beyond)),
+                        detail=f'{comp["counts"]:.3g} counts, {beyond:.3g} of them beyond a Coulomb level higher by '
+                        'alpha dz')
         out.append(comp)
     pe = truth.get('plant_error')
     if pe:

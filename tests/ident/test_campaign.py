@@ -194,6 +194,9 @@ def test_a_deadzone_counts_by_what_a_friction_level_cannot_take_over():
     large = scorer.expected_answer(dz(747.0, 230.0), 2.0)
     assert large['label'] == 'deadzone'
     assert scorer.outcome(large, scorer.predicted_answer(none)) == 'missed'
+    loop = scorer.expected_answer(dz(0.77, 3.3), 2.0)
+    assert loop['label'] == 'none'                # the model without it is nearer than the shifted level
+    assert scorer.components(dz(31.5, 49.0))[0]['counts'] == 31.5
 
 
 @pytest.mark.parametrize('seed, index, play_max', [(2026, 42, 6.0)])
