@@ -62,11 +62,12 @@ def library_names() -> set[str]:
 def components(truth: dict, threshold: float = THRESHOLD) -> list[dict]:
     """Every undeclared discrepancy of a case: effects and a wrong declared constant. A two-mass drive
     whose play alone (truth ``play_contribution_counts_rms``: the drive against its motor side fixed to
-    the cart) stays below ``threshold`` is a cart heavier by the motor side's mass: ``M corrected``. A
-    deadzone counts by what neither of the models without it takes over: the smaller of its whole contribution
-    and what it does beyond a Coulomb level higher by alpha dz (truth ``beyond_friction_counts_rms``: the
-    friction every identification refits takes that part over; in a closed loop the shifted level can move
-    the motion more than the deadzone itself, and the model without it is then the nearer one)."""
+    the cart) stays below ``threshold`` is a cart heavier by the motor side's mass: ``M corrected``; else it
+    counts by its play alone (the heavier cart takes the rest over). A deadzone counts by what neither
+    model without it takes over: the smaller of its whole contribution and what it does beyond a Coulomb
+    level higher by alpha dz (truth ``beyond_friction_counts_rms``: the friction every identification
+    refits takes that part over; in a closed loop the shifted level can move the motion more than the
+    deadzone itself, and the model without it is then the nearer one)."""
     out = []
     for k, v in truth['effects'].items():
         comp = dict(name=k, library=bool(v['library']), counts=float(v['contribution_counts_rms']))
@@ -74,6 +75,10 @@ def components(truth: dict, threshold: float = THRESHOLD) -> list[dict]:
         if k == 'drive_backlash' and play is not None and play < threshold <= comp['counts']:
             comp.update(name='M corrected', detail=f'a drive play of {play:.2g} counts: the motor side '
                         f'({v["motor_mass_kg"]:.3g} kg) moves with the cart')
+        elif k == 'drive_backlash' and play is not None:
+            comp.update(counts=min(comp['counts'], float(play)),
+                        detail=f'{comp["counts"]:.3g} counts, {play:.3g} of them beyond a cart heavier by its '
+                        'motor side')
         beyond = v.get('beyond_friction_counts_rms')
         if k == 'deadzone' and beyond is not None:
             comp.update(counts=min(comp['counts'], float(beyond)),

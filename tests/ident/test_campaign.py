@@ -176,6 +176,7 @@ def test_a_drive_whose_play_is_not_seen_expects_the_mass_of_its_motor_side():
     assert scorer.outcome(hidden, scorer.predicted_answer(mass)) == 'correct'
     seen = scorer.expected_answer(drive(260.0, 3.8), 2.0)
     assert seen['label'] == 'drive_backlash'          # the play itself reaches the threshold
+    assert scorer.components(drive(260.0, 3.8))[0]['counts'] == 3.8     # its size: the play's own part
     assert scorer.outcome(seen, scorer.predicted_answer(play)) == 'correct'
     assert scorer.outcome(seen, scorer.predicted_answer(mass)) == 'wrong'
 
