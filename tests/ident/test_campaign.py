@@ -160,6 +160,16 @@ def test_a_wrong_declared_constant_expects_its_correction_or_not_explained():
     assert scorer.outcome(scorer.expected_answer(cart, 2.0), scorer.predicted_answer(as_m)) == 'alike'
     pendulum = _truth((), {'name': 'l', 'factor': 1.3, 'contribution_counts_rms': 50.0})
     assert scorer.expected_answer(pendulum, 2.0)['label'] == 'not_explained'   # no correction for m, l
+    both = {'effects_added': [], 'constants_corrected': ['M', 'alpha'], 'verdict': {'explained': False}}
+    assert scorer.outcome(scorer.expected_answer(pendulum, 2.0), scorer.predicted_answer(both)) == 'wrong'
+    mass = _truth((), {'name': 'm', 'factor': 1.3, 'contribution_counts_rms': 50.0})
+    exp_m = scorer.expected_answer(mass, 2.0)
+    assert exp_m['label'] == 'not_explained'
+    # the cart's equation times 1.3 is the same model: M and alpha corrected together, not one of them
+    assert scorer.outcome(exp_m, scorer.predicted_answer(both)) == 'alike'
+    assert scorer.outcome(exp_m, scorer.predicted_answer(as_m)) == 'wrong'
+    spring = _truth((('spring', 40.0),), {'name': 'm', 'factor': 1.3, 'contribution_counts_rms': 50.0})
+    assert scorer.outcome(scorer.expected_answer(spring, 2.0), scorer.predicted_answer(both)) == 'wrong'
     assert scorer.detection_limit([(1.0, False), (3.0, True), (5.0, True), (9.0, True)]) == 3.0
     assert scorer.detection_limit([(1.0, True), (3.0, False)]) is None
 
