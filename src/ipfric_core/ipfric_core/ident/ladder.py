@@ -82,7 +82,10 @@ def correction_notes(declared: Model, model: Model, std: dict, cart_alone: bool)
     """A corrected plant constant, as the data say it: 'the declared M is 0.38 kg, the data say 0.52 +/-
     0.01 kg'. On the cart alone (``cart_alone``), where the data fix M / alpha only (paper eq. 2 without
     the pendulum, divided by alpha: (M / alpha) x'' = V - ((beta + eps) / alpha) x' - F / alpha), also the
-    other reading of the same ratio: the other constant as declared, the friction scaled with it."""
+    other reading of the same ratio: the other constant as declared, the friction scaled with it. With the
+    pendulum, M and alpha corrected by one factor k (within two standard errors) are the cart's equation
+    (paper eq. 1) times k, which is also a pendulum mass m declared k times its true value: m enters the
+    cart's equation only (eq. 2 divided by m l is free of it), so the note names that reading too."""
     out = []
     for name in PLANT_CORRECTIONS:
         p = model.param(name)
@@ -100,6 +103,15 @@ def correction_notes(declared: Model, model: Model, std: dict, cart_alone: bool)
                    f'declared {declared["M"] / declared["alpha"]:.4g}): the same motion is {other} = {value:.4g} '
                    f'{model.param(other).unit} with {held} as declared, the friction and the viscous term (beta + '
                    f'eps) times {value / declared[other]:.4g}')
+    if not cart_alone and not fixed and declared['m'] > 0.0:
+        k_m, k_a = model['M'] / declared['M'], model['alpha'] / declared['alpha']
+        s_m, s_a = (std.get('M', math.nan) / declared['M'], std.get('alpha', math.nan) / declared['alpha'])
+        if abs(k_m - k_a) <= 2.0 * math.hypot(s_m, s_a):
+            k = 0.5 * (k_m + k_a)
+            out.append(f'M and alpha are both {k:.4g} times their declared values: the cart\'s equation times {k:.4g} '
+                       f'(the friction and beta + eps with it), which is also the model of a pendulum mass m of '
+                       f'{declared["m"] / k:.4g} kg instead of the declared {declared["m"]:.4g} kg (m enters the '
+                       'cart\'s equation only): these data do not tell the two apart')
     return out
 
 
