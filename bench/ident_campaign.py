@@ -51,6 +51,10 @@ EQUIVALENT = ('beta',)
 #: equation only (the pendulum's own, divided by m l, is free of it), so m declared k times its true value is
 #: the cart's equation times k: M and alpha corrected by k (the friction and beta + eps with them)
 SCALED = {'m': ('M corrected', 'alpha corrected')}
+#: an effect's part that a nearer model without it leaves (truth key, that model): it counts by the smaller
+#: of its whole contribution and that part (:func:`components`)
+OWN_PART = {'drive_backlash': ('play_contribution_counts_rms', 'a cart heavier by its motor side'),
+            'deadzone': ('beyond_friction_counts_rms', 'a Coulomb level higher by alpha dz')}
 THRESHOLD = 2.0          # counts RMS: an effect's contribution from which it must be named
 BINS = (0.0, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 1000.0, math.inf)
 TIMEOUT = 1800.0
@@ -75,19 +79,14 @@ def components(truth: dict, threshold: float = THRESHOLD) -> list[dict]:
     out = []
     for k, v in truth['effects'].items():
         comp = dict(name=k, library=bool(v['library']), counts=float(v['contribution_counts_rms']))
-        play = v.get('play_contribution_counts_rms')
-        if k == 'drive_backlash' and play is not None and play < threshold <= comp['counts']:
-            comp.update(name='M corrected', detail=f'a drive play of {play:.2g} counts: the motor side '
+        key, nearer = OWN_PART.get(k, ('', ''))
+        part = v.get(key)
+        if k == 'drive_backlash' and part is not None and part < threshold <= comp['counts']:
+            comp.update(name='M corrected', detail=f'a drive play of {part:.2g} counts: the motor side '
                         f'({v["motor_mass_kg"]:.3g} kg) moves with the cart')
-        elif k == 'drive_backlash' and play is not None:
-            comp.update(counts=min(comp['counts'], float(play)),
-                        detail=f'{comp["counts"]:.3g} counts, {play:.3g} of them beyond a cart heavier by its '
-                        'motor side')
-        beyond = v.get('beyond_friction_counts_rms')
-        if k == 'deadzone' and beyond is not None:
-            comp.update(counts=min(comp['counts'], float(beyond)),
-                        detail=f'{comp["counts"]:.3g} counts, {beyond:.3g} of them beyond a Coulomb level higher by '
-                        'alpha dz')
+        elif part is not None:
+            comp.update(counts=min(comp['counts'], float(part)),
+                        detail=f'{comp["counts"]:.3g} counts, {part:.3g} of them beyond {nearer}')
         out.append(comp)
     pe = truth.get('plant_error')
     if pe:

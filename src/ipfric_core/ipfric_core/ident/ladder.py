@@ -83,9 +83,9 @@ def correction_notes(declared: Model, model: Model, std: dict, cart_alone: bool)
     0.01 kg'. On the cart alone (``cart_alone``), where the data fix M / alpha only (paper eq. 2 without
     the pendulum, divided by alpha: (M / alpha) x'' = V - ((beta + eps) / alpha) x' - F / alpha), also the
     other reading of the same ratio: the other constant as declared, the friction scaled with it. With the
-    pendulum, M and alpha corrected by one factor k (within two standard errors) are the cart's equation
-    (paper eq. 1) times k, which is also a pendulum mass m declared k times its true value: m enters the
-    cart's equation only (eq. 2 divided by m l is free of it), so the note names that reading too."""
+    pendulum, M and alpha corrected by one factor k (within two standard errors) are the cart's row of paper
+    eq. (1) times k, which is also a pendulum mass m declared k times its true value: m enters that row only
+    (the pendulum's row, divided by m l, is free of it), so the note names that reading too."""
     out = []
     for name in PLANT_CORRECTIONS:
         p = model.param(name)
