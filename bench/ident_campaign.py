@@ -56,6 +56,10 @@ SCALED = {'m': ('M corrected', 'alpha corrected')}
 OWN_PART = {'drive_backlash': ('play_contribution_counts_rms', 'a cart heavier by its motor side'),
             'deadzone': ('beyond_friction_counts_rms', 'a Coulomb level higher by alpha dz')}
 THRESHOLD = 2.0          # counts RMS: an effect's contribution from which it must be named
+#: the smallest play [encoder counts] an encoder shows as a play (ipfric_core.ident.refutations refutes a
+#: drive play under two counts): a smaller one, whatever its contact's ringing does, is scored as the cart
+#: heavier by the motor side
+MIN_PLAY_COUNTS = 2.0
 BINS = (0.0, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 1000.0, math.inf)
 TIMEOUT = 1800.0
 
@@ -70,7 +74,8 @@ def library_names() -> set[str]:
 def components(truth: dict, threshold: float = THRESHOLD) -> list[dict]:
     """Every undeclared discrepancy of a case: effects and a wrong declared constant. A two-mass drive
     whose play alone (truth ``play_contribution_counts_rms``: the drive against its motor side fixed to
-    the cart) stays below ``threshold`` is a cart heavier by the motor side's mass: ``M corrected``; else it
+    the cart) stays below ``threshold``, or whose play is under MIN_PLAY_COUNTS encoder counts, is a cart
+    heavier by the motor side's mass: ``M corrected``; else it
     counts by its play alone (the heavier cart takes the rest over). A deadzone counts by what neither
     model without it takes over: the smaller of its whole contribution and what it does beyond a Coulomb
     level higher by alpha dz (truth ``beyond_friction_counts_rms``: the friction every identification
@@ -81,9 +86,13 @@ def components(truth: dict, threshold: float = THRESHOLD) -> list[dict]:
         comp = dict(name=k, library=bool(v['library']), counts=float(v['contribution_counts_rms']))
         key, nearer = OWN_PART.get(k, ('', ''))
         part = v.get(key)
-        if k == 'drive_backlash' and part is not None and part < threshold <= comp['counts']:
-            comp.update(name='M corrected', detail=f'a drive play of {part:.2g} counts: the motor side '
-                        f'({v["motor_mass_kg"]:.3g} kg) moves with the cart')
+        play = v['gap_m'] / truth['encoder']['x_count_m'] if k == 'drive_backlash' and 'gap_m' in v else math.inf
+        if k == 'drive_backlash' and threshold <= comp['counts'] and (part is not None and part < threshold
+                                                                      or play < MIN_PLAY_COUNTS):
+            why = (f'a play of {play:.2g} encoder counts (the encoder shows no play under {MIN_PLAY_COUNTS:g})'
+                   if play < MIN_PLAY_COUNTS else f'a drive play of {part:.2g} counts')
+            comp.update(name='M corrected', detail=f'{why}: the motor side ({v["motor_mass_kg"]:.3g} kg) moves '
+                        'with the cart')
         elif part is not None:
             comp.update(counts=min(comp['counts'], float(part)),
                         detail=f'{comp["counts"]:.3g} counts, {part:.3g} of them beyond {nearer}')

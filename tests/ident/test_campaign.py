@@ -189,6 +189,12 @@ def test_a_drive_whose_play_is_not_seen_expects_the_mass_of_its_motor_side():
     assert scorer.components(drive(260.0, 3.8))[0]['counts'] == 3.8     # its size: the play's own part
     assert scorer.outcome(seen, scorer.predicted_answer(play)) == 'correct'
     assert scorer.outcome(seen, scorer.predicted_answer(mass)) == 'wrong'
+    tiny = drive(260.0, 10.6)                           # its contact rings, but its play is 0.4 count
+    tiny.update(encoder={'x_count_m': 2.5e-5})
+    tiny['effects']['drive_backlash']['gap_m'] = 1e-5
+    assert scorer.expected_answer(tiny, 2.0)['label'] == 'M corrected'   # as the ladder refutes it
+    tiny['effects']['drive_backlash']['gap_m'] = 7.5e-5                   # three counts: a play to name
+    assert scorer.expected_answer(tiny, 2.0)['label'] == 'drive_backlash'
 
 
 def test_a_deadzone_counts_by_what_a_friction_level_cannot_take_over():

@@ -96,7 +96,12 @@ def test_a_run_time_delay_change_is_in_the_bag_and_in_analyze(tmp_path):
     spans = a['parameter_regimes']
     assert len(spans) == 2 and spans[1]['after'] == ['delay 0.02']
     assert abs(spans[0]['end'] - changes[1][0]) < 0.002       # cut at the change (`delay 0` changed nothing)
-    assert spans[1]['cls'] == 'limit_cycle'                    # 20 ms of delay: gain (23) hunts
+    # 20 ms of delay: gain (23) hunts, twice as wide as it settled. Its class is limit_cycle from a change
+    # at 2.0-7.0 s, but once (a full CI run) irregular: the sample the change lands at follows the wall
+    # clock, and the stretch after it is judged as a whole
+    before, after = spans
+    assert after['cls'] in ('limit_cycle', 'irregular'), spans
+    assert after['x_p2p'] > 1.5 * before['x_p2p'] and after['theta_p2p'] > 1.5 * before['theta_p2p'], spans
 
 
 @pytest.mark.parametrize('node', ['sim_node', 'controller_node', 'recorder'])
