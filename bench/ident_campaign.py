@@ -5,6 +5,8 @@ that shares nothing with ipfric_core), each identified by ``ipfric identify`` an
     python -m bench.ident_campaign --out runs/campaign --rescore      # score existing results again
     python -m bench.ident_campaign --out runs/campaign --cases 200 --seed 1 --resume   # go on after a stop
     python -m bench.ident_campaign --out runs/all --merge runs/part1 runs/part2/summary.json   # one summary
+    python -m bench.ident_campaign --out runs/rest --cases 200 --seed 2027 --except bench/campaign/seed2027.json
+                                                  # the cases a kept part does not hold (same code)
 
 A case's expected answer: the library effect(s) whose own contribution (truth
 ``contribution_counts_rms``: multiple shooting on 1 s windows, cart encoder counts; angle counts
@@ -665,6 +667,35 @@ def rescore(out_dir, threshold=THRESHOLD, with_oracle=False) -> dict:
     return write_summary(Path(out_dir), cases, threshold, dict(old, rescored=True))
 
 
+def part_rows(src: Path, threshold=THRESHOLD) -> tuple[list[dict], dict]:
+    """The scored cases and the meta of one part of a campaign: a campaign directory (scored again) or a
+    summary.json (its scored cases, kept: a part whose cases are gone, e.g. one kept in bench/campaign/)."""
+    if src.is_dir():
+        return scored(src, threshold)
+    if src.is_file():
+        s = json.loads(src.read_text())
+        if s.get('threshold_counts') != threshold:
+            raise SystemExit(f'{src} was scored at {s.get("threshold_counts")} counts, not {threshold}')
+        return s['cases'], s.get('meta', {})
+    raise SystemExit(f'{src} is neither a campaign directory nor a summary.json')
+
+
+def not_held(indices, parts, seed, threshold=THRESHOLD) -> list[int]:
+    """The case ``indices`` that none of ``parts`` (directories or summary.json of this seed, identified by
+    this tree's code) holds: what a campaign kept in parts still has to run (--except)."""
+    left = list(indices)
+    for part in map(Path, parts):
+        rows, meta = part_rows(part, threshold)
+        if meta.get('seed') != seed:
+            raise SystemExit(f'--except: {part} holds the draw of seed {meta.get("seed")}, not {seed}')
+        if meta.get('commit') != code_commit():
+            raise SystemExit(f'--except: {part} holds the answers of code {meta.get("commit")}, this tree is '
+                             f'{code_commit()} (its parts would not merge)')
+        held = {c['case'] for c in rows}
+        left = [i for i in left if campaign.case_name(i) not in held]
+    return left
+
+
 def merge(out_dir, sources, threshold=THRESHOLD) -> dict:
     """One summary of the cases of several parts of one campaign: each source a campaign directory
     (scored again) or a summary.json (its scored cases, kept: a part whose cases are gone). The parts
@@ -672,15 +703,7 @@ def merge(out_dir, sources, threshold=THRESHOLD) -> dict:
     cases: dict[str, dict] = {}
     seeds, commits = set(), set()
     for src in map(Path, sources):
-        if src.is_dir():
-            rows, meta = scored(src, threshold)
-        elif src.is_file():
-            s = json.loads(src.read_text())
-            if s.get('threshold_counts') != threshold:
-                raise SystemExit(f'--merge: {src} was scored at {s.get("threshold_counts")} counts, not {threshold}')
-            rows, meta = s['cases'], s.get('meta', {})
-        else:
-            raise SystemExit(f'--merge: {src} is neither a campaign directory nor a summary.json')
+        rows, meta = part_rows(src, threshold)
         seeds.add(meta.get('seed'))
         commits.add(meta.get('commit'))
         for c in rows:
@@ -711,13 +734,17 @@ def main(argv=None) -> int:
                     help='keep the cases --out already holds from this seed and this code; identify the rest')
     ap.add_argument('--merge', nargs='+', metavar='PART',
                     help='write one summary into --out of these parts of one campaign (directories or summary.json)')
+    ap.add_argument('--except', dest='skip', nargs='+', metavar='PART', default=[],
+                    help='leave out the cases these parts (directories or summary.json) already hold: a campaign '
+                         'kept in bench/campaign/ goes on with the rest')
     a = ap.parse_args(argv)
     if a.merge:
         s = merge(a.out, a.merge, a.threshold)
     elif a.rescore:
         s = rescore(a.out, a.threshold, not a.no_oracle)
     else:
-        idx = [int(i) for i in a.indices.split(',')] if a.indices else None
+        idx = [int(i) for i in a.indices.split(',')] if a.indices else list(range(a.cases))
+        idx = not_held(idx, a.skip, a.seed, a.threshold)
         s = run_campaign(a.out, a.cases, a.seed, a.workers, lambda m: print(m, flush=True), a.threshold, idx,
                          a.timeout, with_oracle=not a.no_oracle, resume=a.resume)
     print(Path(a.out) / 'summary.md')

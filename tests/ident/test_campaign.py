@@ -308,6 +308,14 @@ def test_merge_joins_parts_of_one_campaign_and_refuses_others(tmp_path, monkeypa
     assert [c['case'] for c in s['cases']] == ['case0002', 'case0003']
     assert s['meta']['seed'] == SEED and s['meta']['commit'] == 'abc1234' and s['n_cases'] == 2
     assert '2 cases' in (tmp_path / 'all' / 'summary.md').read_text()
+    # a campaign kept as that summary goes on with the cases it does not hold
+    assert scorer.not_held(range(5), [tmp_path / 'all' / 'summary.json'], SEED) == [0, 1, 4]
+    with pytest.raises(SystemExit, match=f'holds the draw of seed {SEED}, not {SEED + 1}'):
+        scorer.not_held(range(5), [tmp_path / 'all' / 'summary.json'], SEED + 1)
+    with pytest.raises(SystemExit, match='holds the answers of code abc1234, this tree is def5678'):
+        monkeypatch.setattr(scorer, 'code_commit', lambda: 'def5678')
+        scorer.not_held(range(5), [tmp_path / 'all' / 'summary.json'], SEED)
+    monkeypatch.setattr(scorer, 'code_commit', lambda: 'abc1234')
     with pytest.raises(SystemExit, match='case0002 is in two parts'):
         scorer.merge(tmp_path / 'x', [tmp_path / 'a', tmp_path / 'a' / 'summary.json'])
     with pytest.raises(SystemExit, match='scored at 2.0 counts, not 3.0'):
