@@ -564,7 +564,8 @@ def done_cases(out_dir: Path, seed: int, commit: str) -> set[str]:
 
 def run_campaign(out_dir, n_cases, seed, workers=1, progress=None, threshold=THRESHOLD, indices=None,
                  timeout=TIMEOUT, generate_workers=None, with_oracle=True, resume=False) -> dict:
-    """Generate cases (seed, i), identify each (``workers`` identifications at a time), score;
+    """Generate cases (seed, i), identify each (``workers`` identifications at a time, each batch of
+    ``workers`` cases generated just before it is identified), score;
     returns the summary (also written to out_dir/summary.json, summary.md, detection.png).
     ``with_oracle``: also the identification's error of the true model on each case (:func:`oracle`).
     ``resume``: keep the cases already identified in ``out_dir`` by this code (:func:`done_cases`) and
@@ -577,18 +578,24 @@ def run_campaign(out_dir, n_cases, seed, workers=1, progress=None, threshold=THR
     say = progress or (lambda msg: None)
     commit = code_commit()
     done = done_cases(out_dir, seed, commit) if resume else set()
-    old = json.loads((case_root / 'manifest.json').read_text()) if done else {'generation_s': {}, 'cases': {}}
+    manifest = (json.loads((case_root / 'manifest.json').read_text()) if done
+                else {'generation_s': {}, 'cases': {}})
     todo = [i for i in indices if campaign.case_name(i) not in done]
-    t0 = time.perf_counter()
-    manifest = (campaign.generate(case_root, len(todo), seed, todo, generate_workers or workers,
-                                  lambda case, s: say(f'generated {case} in {s:.1f} s'))
-                if todo else {'generation_s': {}, 'cases': {}})
-    gen_wall = time.perf_counter() - t0
     if done:
         say(f'resumed: {len(done)} cases already identified by {commit}, {len(todo)} to go')
-        manifest = dict(old, indices=sorted(set(old.get('indices', [])) | set(todo)),
-                        generation_s={**old['generation_s'], **manifest['generation_s']},
-                        cases={**old['cases'], **manifest['cases']})
+    t0 = time.perf_counter()
+    gen_wall = 0.0
+
+    def generated(batch: list[int]) -> None:
+        """Generate the cases ``batch`` and fold them into the manifest (written at once: a stop keeps them)."""
+        nonlocal manifest, gen_wall
+        t = time.perf_counter()
+        m = campaign.generate(case_root, len(batch), seed, batch, min(generate_workers or workers, len(batch)),
+                              lambda case, sec: say(f'generated {case} in {sec:.1f} s'))
+        gen_wall += time.perf_counter() - t
+        manifest = dict(m, indices=sorted(set(manifest.get('indices', [])) | set(batch)),
+                        generation_s={**manifest['generation_s'], **m['generation_s']},
+                        cases={**manifest['cases'], **m['cases']})
         (case_root / 'manifest.json').write_text(json.dumps(manifest, indent=1, sort_keys=True))
     names = [campaign.case_name(i) for i in indices]
 
@@ -609,18 +616,18 @@ def run_campaign(out_dir, n_cases, seed, workers=1, progress=None, threshold=THR
         os.replace(tmp, d / 'ident' / 'meta.json')
         return score_case(truth, ident, threshold, manifest['generation_s'].get(name), orc)
 
+    # a batch of ``workers`` cases at a time, generated then identified: a stop keeps every case done so far
     cases = []
-    if workers > 1:
-        from concurrent.futures import ThreadPoolExecutor
-        with ThreadPoolExecutor(workers) as ex:
-            for c in ex.map(one, names):
+    from concurrent.futures import ThreadPoolExecutor
+    with ThreadPoolExecutor(workers) as ex:
+        for at in range(0, len(indices), workers):
+            batch = indices[at:at + workers]
+            fresh = [i for i in batch if i in todo]
+            if fresh:
+                generated(fresh)
+            for c in ex.map(one, names[at:at + workers]):
                 cases.append(c)
                 say(f'{c["case"]}: expected {c["expected"]}, answer {c["predicted"]} ({c["outcome"]}), {c["wall_s"]} s')
-    else:
-        for name in names:
-            c = one(name)
-            cases.append(c)
-            say(f'{c["case"]}: expected {c["expected"]}, answer {c["predicted"]} ({c["outcome"]}), {c["wall_s"]} s')
     meta = dict(seed=seed, indices=indices, workers=workers, commit=commit, resumed_cases=len(done & set(names)),
                 generation_wall_s=round(gen_wall, 1),
                 total_wall_s=round(time.perf_counter() - t0, 1),
