@@ -64,19 +64,20 @@ def matching_commands(peer, topics):
 
 
 def bogus_joint_states(peer, topics):
-    """A 'fallen' angle at 1 kHz, stamped as the rig's current samples."""
-    from builtin_interfaces.msg import Time
+    """A 'fallen' angle stamped as each of the rig's samples, published as soon as the sample is seen."""
     from sensor_msgs.msg import JointState
     pub = peer.node.create_publisher(JointState, topics.JOINT_STATES, topics.data_qos())
-    t0 = time.monotonic()
+    sent = set()
 
-    def tick():
-        k = int((time.monotonic() - t0) * 1000)
-        msg = JointState(name=list(topics.JOINT_NAMES), position=[0.0, 0.4])
-        msg.header.stamp = Time(sec=k // 1000, nanosec=(k % 1000) * 1_000_000)
-        pub.publish(msg)
-        time.sleep(1e-3)
-    return tick
+    def mirror(msg):                                # our own copies come back with a stamp already sent
+        stamp = topics.stamp_to_ns(msg.header.stamp)
+        if stamp not in sent:
+            sent.add(stamp)
+            bogus = JointState(name=list(topics.JOINT_NAMES), position=[0.0, 0.4])
+            bogus.header.stamp = msg.header.stamp
+            pub.publish(bogus)
+    peer.node.create_subscription(JointState, topics.JOINT_STATES, mirror, topics.data_qos())
+    return lambda: peer.executor.spin_once(timeout_sec=0.01)
 
 
 @pytest.mark.parametrize('stranger', [idle, command_flood, matching_commands, bogus_joint_states],
