@@ -563,14 +563,15 @@ def done_cases(out_dir: Path, seed: int, commit: str) -> set[str]:
 
 
 def run_campaign(out_dir, n_cases, seed, workers=1, progress=None, threshold=THRESHOLD, indices=None,
-                 timeout=TIMEOUT, generate_workers=None, with_oracle=True, resume=False) -> dict:
+                 timeout=TIMEOUT, generate_workers=None, with_oracle=True, resume=False, duration=None) -> dict:
     """Generate cases (seed, i), identify each (``workers`` identifications at a time, each batch of
     ``workers`` cases generated just before it is identified), score;
     returns the summary (also written to out_dir/summary.json, summary.md, detection.png).
     ``with_oracle``: also the identification's error of the true model on each case (:func:`oracle`).
     ``resume``: keep the cases already identified in ``out_dir`` by this code (:func:`done_cases`) and
     generate and identify only the others (a campaign of hundreds of cases goes on after a stop). With
-    several workers each identification's simulations share the cores among them (NUMBA_NUM_THREADS)."""
+    several workers each identification's simulations share the cores among them (NUMBA_NUM_THREADS).
+    ``duration`` [s]: every case this long instead of its drawn length (a quick check that the campaign runs)."""
     out_dir = Path(out_dir)
     threads = max(1, (os.cpu_count() or 1) // workers) if workers > 1 else None
     case_root = out_dir / 'cases'
@@ -591,7 +592,7 @@ def run_campaign(out_dir, n_cases, seed, workers=1, progress=None, threshold=THR
         nonlocal manifest, gen_wall
         t = time.perf_counter()
         m = campaign.generate(case_root, len(batch), seed, batch, min(generate_workers or workers, len(batch)),
-                              lambda case, sec: say(f'generated {case} in {sec:.1f} s'))
+                              lambda case, sec: say(f'generated {case} in {sec:.1f} s'), duration)
         gen_wall += time.perf_counter() - t
         manifest = dict(m, indices=sorted(set(manifest.get('indices', [])) | set(batch)),
                         generation_s={**manifest['generation_s'], **m['generation_s']},

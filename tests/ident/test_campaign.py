@@ -4,13 +4,14 @@ bench/ident_campaign.py).
 Fast: the generator is reproducible (the same (seed, index) gives the same bytes) and every drawn
 case is physically sane; the scorer's rules on hand-made answers.
 
-Slow (in the default suite, the subset CI runs): ten fixed cases of seed 2026, drawn as the campaign
-draws them but each CI_DURATION long (LONGER for some), identified by ``ipfric identify`` as the campaign runs it (two
-at a time), each with the answer it should give: a clean cart and a clean balancing loop, a deadzone
-and a cogging in balancing loops, an offset, a delay, an angle encoder's bias, a two-mass drive, a
-hanging pendulum's direction dependence, and a spring from outside the library that must come back
-"not explained". The whole draw (hundreds of cases, each as long as drawn) is ``python -m
-bench.ident_campaign``.
+Slow: ten fixed cases of seed 2026, drawn as the campaign draws them but each CI_DURATION long (LONGER
+for some), identified by ``ipfric identify`` as the campaign runs it (two at a time), each with the
+answer it should give: a clean cart and a clean balancing loop, a deadzone and a cogging in balancing
+loops, an offset, a delay, an angle encoder's bias, a two-mass drive, a hanging pendulum's direction
+dependence, and a spring from outside the library that must come back "not explained". The default
+run (what CI runs) identifies IN_SUITE, the four without a balancing loop (a balancing loop's
+identification takes minutes: the others are marked long; ``-m long`` runs them). The whole draw
+(hundreds of cases, each as long as drawn) is ``python -m bench.ident_campaign``.
 """
 import json
 import math
@@ -43,6 +44,8 @@ FIXED = {
          'drive_backlash'),
     32: ('cart alone, a spring towards the centre (outside the library, 96 counts)', 'not_explained'),
 }
+#: the fixed cases of the default run: a clean cart, an offset with overruns, a hanging pendulum, a spring
+IN_SUITE = (2, 66, 89, 32)
 
 
 # ------------------------------------------------------------------------------------------ fast
@@ -227,11 +230,14 @@ def test_the_generator_parts_a_drive_into_its_play_and_its_mass(seed, index, pla
 
 # ------------------------------------------------------------------------------------------ slow
 @pytest.fixture(scope='module')
-def fixed_cases(tmp_path_factory):
-    """Each fixed case's truth and identification (two identifications at a time, as the campaign runs)."""
+def fixed_cases(request, tmp_path_factory):
+    """The truth and identification of each fixed case this session runs (two identifications at a time,
+    as the campaign runs)."""
     out = tmp_path_factory.mktemp('campaign_fixed')
-    for duration in {LONGER.get(i, CI_DURATION) for i in FIXED}:
-        campaign.generate(out, 0, SEED, indices=[i for i in FIXED if LONGER.get(i, CI_DURATION) == duration],
+    run = [i for i in FIXED if any(item.name.startswith(f'test_fixed_case_is_identified_right[{i}-')
+                                   for item in request.session.items)]
+    for duration in {LONGER.get(i, CI_DURATION) for i in run}:
+        campaign.generate(out, 0, SEED, indices=[i for i in run if LONGER.get(i, CI_DURATION) == duration],
                           duration=duration)
 
     def one(index):
@@ -239,11 +245,12 @@ def fixed_cases(tmp_path_factory):
         truth = json.loads((d / 'truth.json').read_text())
         return index, (truth, scorer.identify_case(d, truth, threads=1))
     with ThreadPoolExecutor(2) as ex:
-        return dict(ex.map(one, FIXED))
+        return dict(ex.map(one, run))
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize('index', [pytest.param(i, id=f'{i}-{right}') for i, (_, right) in FIXED.items()])
+@pytest.mark.parametrize('index', [pytest.param(i, id=f'{i}-{right}', marks=[] if i in IN_SUITE else [pytest.mark.long])
+                                   for i, (_, right) in FIXED.items()])
 def test_fixed_case_is_identified_right(fixed_cases, index):
     what, right = FIXED[index]
     truth, ident = fixed_cases[index]

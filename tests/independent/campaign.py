@@ -99,7 +99,7 @@ import numpy as np
 
 from . import rigsim
 
-_jit = numba.njit(cache=False)
+_jit = numba.njit(cache=True)     # compiled once per machine, into tests/independent/__pycache__
 
 VERSION = 2
 TRACK = 0.40            # the cart must stay within +-TRACK [m] (true position)

@@ -61,7 +61,7 @@ import numba
 import numpy as np
 from scipy.linalg import solve_continuous_are
 
-_jit = numba.njit(cache=False)
+_jit = numba.njit(cache=True)     # compiled once per machine, into tests/independent/__pycache__
 
 TRACK = 0.35                      # usable half-length of the track [m]
 SUBSTEP = 1e-4                    # default internal integration step [s]
