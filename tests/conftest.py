@@ -17,25 +17,18 @@ def pytest_collection_modifyitems(items):
             item.add_marker(pytest.mark.ros)
 
 
-def ros_files() -> set[str]:
-    """The test files that start ROS 2 processes (under tests/ros, or marked ``ros``), relative to the root."""
-    tests = ROOT / 'tests'
-    return {str(p.relative_to(ROOT)) for p in tests.rglob('test_*.py')
-            if tests / 'ros' in p.parents or 'pytest.mark.ros' in p.read_text()}
-
-
 @pytest.hookimpl(optionalhook=True)
 def pytest_xdist_make_scheduler(config, log):
     """``./ipfric test`` on two workers (pytest-xdist): every file is one unit (its module fixtures are
-    computed once), and the files that start ROS 2 processes are a single unit, run one after another on
-    one worker (their runs wait on the wall clock; two at a time on two cores would share them)."""
+    computed once), and the files of tests/ros are a single unit, run one after another on one worker
+    (their runs share the run-time checks of one rig at a time; the other files that start ROS 2
+    processes, a few runs each, may run beside them)."""
     from xdist.scheduler import LoadScopeScheduling
-    ros = ros_files()
 
     class FileScheduling(LoadScopeScheduling):
         def _split_scope(self, nodeid: str) -> str:
             path = nodeid.split('::', 1)[0]
-            return 'ros' if path in ros else path
+            return 'tests/ros' if path.startswith('tests/ros/') else path
     return FileScheduling(config, log)
 
 

@@ -1,7 +1,7 @@
 """Helpers of the ROS tests: scenario files, node processes and an in-process peer.
 
 Every process and the in-process rclpy context get a ROS_DOMAIN_ID of their own (a free
-one, :func:`ipfric_core.run.runner.pick_domain`) and ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST.
+one, held: :func:`ipfric_core.run.runner.claim_domain`) and ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST.
 """
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from ipfric_core.run.runner import Run, executable, pick_domain, ros_environment
+from ipfric_core.run.runner import Run, claim_domain, executable, ros_environment
 from ipfric_core.run.scenario import SECTION_KEYS
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -60,7 +60,8 @@ class Peer:
         from rclpy.executors import SingleThreadedExecutor
         assert os.environ.get('ROS_AUTOMATIC_DISCOVERY_RANGE') == 'LOCALHOST', \
             'run the tests through ./ipfric test (scripts/env.sh keeps DDS on loopback)'
-        self.domain = domain if domain is not None else pick_domain()
+        self.lock = claim_domain() if domain is None else None     # held: runs started beside it pick others
+        self.domain = domain if self.lock is None else self.lock.domain
         self.context = rclpy.Context()
         rclpy.init(context=self.context, domain_id=self.domain)
         self.node = rclpy.create_node(name, context=self.context)
@@ -77,6 +78,8 @@ class Peer:
         self.executor.shutdown()
         self.node.destroy_node()
         self.context.try_shutdown()
+        if self.lock is not None:
+            self.lock.release()
 
 
 def started(log: Path, proc, timeout: float = 120.0) -> None:

@@ -16,7 +16,7 @@ BENCHMARKS = ('closed loop 2 s, Fig. 7', 'closed loop 2 s vs MuJoCo', 'limit cyc
 
 
 @pytest.mark.ros
-@pytest.mark.slow
+@pytest.mark.long       # two minutes or more: every benchmark, a ROS run and a campaign case among them
 def test_quick_bench_runs_every_benchmark(tmp_path):
     results = tmp_path / 'RESULTS.md'
     out = subprocess.run([sys.executable, '-m', 'ipfric_core.cli', 'bench', '--quick', '--json',

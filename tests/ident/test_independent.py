@@ -68,9 +68,9 @@ def data(tmp_path_factory):
 
 
 #: the cases of the default run (a clean record and an effect for the closed loop, a clean cart); the others
-#: are marked long (the default run's campaign cases cover a deadzone, an offset and a drive on other rigs:
+#: are marked long (the default run's campaign cases cover an offset and a spring on other rigs:
 #: tests/ident/test_campaign.py)
-IN_SUITE = ('cart_none', 'loop_none', 'loop_delay', 'loop_bias')
+IN_SUITE = ('cart_none', 'loop_none', 'loop_delay')
 
 
 @pytest.mark.slow
@@ -118,7 +118,7 @@ def test_a_friction_rising_with_speed_is_found_in_independent_data(tmp_path):
     assert res['verdict']['explained'], res['verdict']
 
 
-@pytest.mark.slow
+@pytest.mark.long       # a minute: the friction laws' ladder on a 45 s record
 def test_a_cart_without_coulomb_friction_is_answered_by_the_viscous_law(tmp_path):
     """The independent simulator's cart on an air bearing (no Coulomb or static friction: mu_s = mu_c = 0,
     viscous 3 N s/m), 45 s, declared with the paper's Stribeck curve: the refit loses its Coulomb level to
