@@ -21,8 +21,8 @@ def pytest_collection_modifyitems(items):
 def pytest_xdist_make_scheduler(config, log):
     """``./ipfric test`` on two workers (pytest-xdist): every file is one unit (its module fixtures are
     computed once), and the files of tests/ros are a single unit, run one after another on one worker
-    (their runs share the run-time checks of one rig at a time; the other files that start ROS 2
-    processes, a few runs each, may run beside them)."""
+    (their runs wait on the wall clock; the few runs of other files that start ROS 2 processes may run
+    beside them, each in a domain it holds)."""
     from xdist.scheduler import LoadScopeScheduling
 
     class FileScheduling(LoadScopeScheduling):
