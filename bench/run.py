@@ -261,9 +261,39 @@ def bench_analyze(bag: Path, small: Path, minutes: float) -> list[dict]:
              'target': '< 5 s, bounded memory', 'met': wall < 5.0 and rss - rss_small < size}]
 
 
+#: one simulation of the 2-minute record's estimation part (its first 60 %, 72000 samples: the cart's and
+#: the angle's windows) took about 28 ms of CPU when the identification's target of 60 s was met
+#: (docs/performance.md, 2026-11-25): 60 s is about 2100 such simulations, a target that moves with the machine
+SIMULATIONS_IN_60_S = 2100
+
+
+def simulation_time(record: Path, repeats: int = 15) -> float:
+    """The median wall time [s] of one simulation of ``record``'s estimation part (identify's default
+    split) with its declared model (the paper's exponential law, Table 1's plant): every window of the
+    cart and of the angle replayed once, the unit of the identification's work
+    (``ident/shooting.predict``), measured in this process after a first call that compiles."""
+    from ipfric_core.analysis.records import load
+    from ipfric_core.ident import shooting
+    from ipfric_core.ident.model import declared, read_declared
+    from ipfric_core.physics.params import PlantParams
+    plant, friction = read_declared(None, 'exponential')
+    rec = load(record, plant).split(0.6)[0]
+    model = declared(plant or rec.plant or PlantParams(), friction, rec.theta is not None).vectors()
+    windows = [shooting.cart_windows(rec)] + ([shooting.angle_windows(rec)] if rec.theta is not None else [])
+
+    def once() -> float:
+        t0 = time.perf_counter()
+        for w in windows:
+            shooting.predict(model, rec, w)
+        return time.perf_counter() - t0
+    once()
+    return statistics.median(once() for _ in range(repeats))
+
+
 def bench_identify(quick: bool) -> list[dict]:
     """./ipfric identify on the EMPS files and on a 2-minute 1 kHz closed-loop record of the
-    independent rig simulator (tests/independent), if this tree has that command."""
+    independent rig simulator (tests/independent), if this tree has that command; the record's row
+    beside one simulation of it, measured in the same run (the ratio: simulations' worth of work)."""
     base = [sys.executable, '-m', 'ipfric_core.cli', 'identify']
     helped = subprocess.run(base + ['--help'], capture_output=True, text=True)
     out_dir = REPO_ROOT / 'runs' / 'bench-identify'
@@ -279,9 +309,14 @@ def bench_identify(quick: bool) -> list[dict]:
         if quick:
             rows.append({**row, 'ipfric': 'available (not run in quick mode)', 'met': None})
             continue
+        sim = None
         if args is None:
             from tests.independent import rigsim
             args = [str(rigsim.write_case('loop_cogging', out_dir, duration=120.0))]
+            sim = simulation_time(Path(args[0]))
+            row.update(reference=f'one simulation of the record\'s estimation part: {1e3 * sim:.3g} ms',
+                       target=f'< 60 s, and < {SIMULATIONS_IN_60_S} simulations (60 s at 28 ms a simulation, '
+                              f'the machine the target was set on)')
         t0 = time.perf_counter()
         out = subprocess.run(base + args + ['--out', str(out_dir / ('emps' if args[0].endswith('.mat') else 'loop')),
                                             '--json', '--no-plots'],
@@ -290,8 +325,12 @@ def bench_identify(quick: bool) -> list[dict]:
         if out.returncode != 0:
             tail = (out.stderr.strip().splitlines() or ['?'])[-1]
             rows.append({**row, 'ipfric': f'failed after {wall:.3g} s: {tail}', 'met': False})
-        else:
+        elif sim is None:
             rows.append({**row, 'ipfric': f'{wall:.3g} s', 'met': wall < 60.0})
+        else:
+            ratio = wall / sim
+            rows.append({**row, 'ipfric': f'{wall:.3g} s, {ratio:.0f} simulations\' worth', 'ratio': round(ratio),
+                         'met': ratio < SIMULATIONS_IN_60_S})
     return rows
 
 
