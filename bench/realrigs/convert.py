@@ -337,8 +337,20 @@ def write_log(path: Path, t, x, v, theta) -> dict:
                 theta=theta is not None)
 
 
+def unknown_names(only: list[str] | None) -> str | None:
+    """Why ``only`` (rig or rig/log names) names no log of :data:`LOGS` (the names that match none, and
+    the rigs there are); None when every name matches."""
+    known = set(LOGS) | {f'{rig}/{log}' for rig, logs in LOGS.items() for log in logs}
+    bad = [n for n in only or [] if n not in known]
+    if not bad:
+        return None
+    return (f'--only: {", ".join(bad)} is no rig or rig/log; rigs: {", ".join(LOGS)} (their logs: the table of '
+            'bench/realrigs/convert.py, or manifest.json of a conversion)')
+
+
 def convert(out: Path, mirror: Path = MIRROR, only: list[str] | None = None) -> list[dict]:
-    """Convert every log (or those of ``only``: rig or rig/log names) into ``out``; the manifest rows."""
+    """Convert every log (or those of ``only``: rig or rig/log names) into ``out``; the manifest rows (with
+    ``only``, manifest.json keeps the rows of the other logs already converted there)."""
     rows: list[dict] = []
     snaps: dict[str, Snapshot] = {}
     for rig, logs in LOGS.items():
@@ -357,7 +369,12 @@ def convert(out: Path, mirror: Path = MIRROR, only: list[str] | None = None) -> 
                              commits=sorted({c for _, c in snap.read_log}), note=log['note'], **row))
             print(f'{rig}/{name}: {row["rows"]} rows, {row["duration_s"]} s, dt {row["dt_s"]} s'
                   + ('' if row['theta'] else ', no angle'), flush=True)
-    (out / 'manifest.json').write_text(json.dumps(rows, indent=1))
+    done = {(r['rig'], r['log']) for r in rows}
+    kept = json.loads((out / 'manifest.json').read_text()) if only and (out / 'manifest.json').exists() else []
+    order = {(rig, log): i for i, (rig, log) in enumerate((rig, log) for rig, logs in LOGS.items() for log in logs)}
+    merged = sorted([r for r in kept if (r['rig'], r['log']) not in done] + rows,
+                    key=lambda r: order.get((r['rig'], r['log']), len(order)))
+    (out / 'manifest.json').write_text(json.dumps(merged, indent=1))
     return rows
 
 
@@ -372,7 +389,10 @@ def main(argv=None) -> int:
     if probe.returncode == 1:        # 0: ignored, 128: outside the repository
         sys.exit(f'{args.out}: in the repository and not ignored by git; these logs must never be committed '
                  '(write them under runs/ or outside the repository)')
-    rows = convert(args.out, args.mirror, args.only.split(',') if args.only else None)
+    only = args.only.split(',') if args.only else None
+    if why := unknown_names(only):
+        ap.error(why)
+    rows = convert(args.out, args.mirror, only)
     print(f'{len(rows)} logs in {args.out}')
     return 0
 

@@ -18,7 +18,7 @@ import sys
 import time
 from pathlib import Path
 
-from .convert import LOGS
+from .convert import LOGS, unknown_names
 
 ROOT = Path(__file__).resolve().parents[2]
 HEADER = ('| rig / log | exit | wall s | kept (effects, corrections, law) | verdict: motion left (floor) '
@@ -51,8 +51,10 @@ def row(rig: str, log: str, run: dict, result: dict | None) -> dict:
     kept += [s['step'] for s in result['ladder'] if s['step'].endswith(' as declared')]
     v = result['verdict']
     params = {p['name']: p for p in result['ladder'][-1]['params']}
-    friction = (f'{params["Fc"]["value"]:.3g}, {params["Fs_excess"]["value"]:.2g}' if 'Fc' in params
-                else 'viscous law')
+    def level(name: str, digits: int) -> str:
+        p = params[name]
+        return f'{p["value"]:.{digits}g}' + ('' if p['fitted'] else ' (held)')
+    friction = f'{level("Fc", 3)}, {level("Fs_excess", 2)}' if 'Fc' in params else 'viscous law'
     bound = ', '.join(n for n, p in params.items() if p['at_bound']) or 'none'
     return dict(out, kept=', '.join(kept) or 'none', friction=friction, bound=bound,
                 verdict=f'{"explained" if v["explained"] else "not explained"}: {v["unexplained_percent"]:.3g} % '
@@ -79,7 +81,7 @@ def identify_all(data: Path, runs: Path, only: list[str] | None = None, resume: 
                 run = identify(csv, out)
             result = json.loads((out / 'result.json').read_text()) if run['exit'] == 0 else None
             rows.append(row(rig, log, run, result))
-            print(markdown(rows[-1:]).split('\n')[-2], flush=True)
+            print(markdown(rows[-1:]).split('\n')[-2] if len(rows) > 1 else markdown(rows).rstrip(), flush=True)
     runs.mkdir(parents=True, exist_ok=True)
     (runs / 'rows.json').write_text(json.dumps(rows, indent=1))
     (runs / 'table.md').write_text(markdown(rows))
@@ -93,10 +95,19 @@ def main(argv=None) -> int:
     ap.add_argument('--only', help='comma-separated rig or rig/log names (default: every log of DATA)')
     ap.add_argument('--resume', action='store_true', help='skip the logs whose result.json exists')
     args = ap.parse_args(argv)
-    rows = identify_all(args.data.resolve(), args.out.resolve(), args.only.split(',') if args.only else None,
-                        args.resume)
+    only = args.only.split(',') if args.only else None
+    if why := unknown_names(only):
+        ap.error(why)
+    if not (args.data / 'manifest.json').is_file():
+        ap.error(f'{args.data}: no manifest.json; give the directory that bench.realrigs.convert --out wrote')
+    rows = identify_all(args.data.resolve(), args.out.resolve(), only, args.resume)
+    if not rows:
+        ap.error(f'no converted log of {args.data} is among --only {args.only}')
     print(f'\n{markdown(rows)}{len(rows)} logs; table in {args.out / "table.md"}')
-    return 0
+    failed = [f'{r["rig"]}/{r["log"]} (exit {r["exit"]})' for r in rows if r['exit'] not in (0, 2)]
+    if failed:      # exit 2 is identify's refusal with its reason (too few windows): an answer, not a failure
+        print(f'identify failed on {len(failed)} log(s): {", ".join(failed)}', file=sys.stderr)
+    return 1 if failed else 0
 
 
 if __name__ == '__main__':

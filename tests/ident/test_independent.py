@@ -211,6 +211,9 @@ def test_drive_play_found_sized_and_exported(data, tmp_path, capsys):
     assert not any(p['at_bound'] for p in final.values())
     errors = [s['validation']['x_rms_counts'] for s in r['ladder']]
     assert errors[-1] < 0.1 * errors[0]          # 30 counts of coasting through the play explained
+    # the report names no figure it did not draw, and no cogging period without a cogging
+    assert not r['figures'] and 'Figures:' not in (tmp_path / 'r' / 'report.md').read_text()
+    assert 'cogging_period_m' not in r['identified']['plant_truth']
     truth = load_scenario(out).truth
     assert truth.drive_backlash_m == pytest.approx(final['drive_backlash_m']['value'])
     assert truth.drive_mass_kg == pytest.approx(final['drive_mass_kg']['value'])

@@ -31,7 +31,7 @@ from .hypotheses import PLANT_CORRECTIONS, Hypothesis, errors_of, full_fit, hypo
 from .judging import WORSE_PERCENT, Judged, beyond_refit, contribution, judge, leaner_first, verdict
 from .model import FRICTION_FITTED, LAW_PARAMS, Model
 from .problem import Problem, fit_model
-from .refutations import near, on_bounds, uncorrected, unresolved, untold
+from .refutations import near, never_starts, on_bounds, uncorrected, unresolved, untold
 from .starts import DRIVE_GRID, balance_starts
 
 __all__ = ['Step', 'run_ladder']
@@ -172,7 +172,8 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
             break
         win = ok[0]
         current, s = fit_model(pe, win.model, max_nfev=60, prior=declared)   # every fitted parameter together
-        if on_bounds(current) or untold(current, s) or pv.cost(current) > pv.cost(win.model):
+        if on_bounds(current) or untold(current, s) or never_starts(pe.rec, current) \
+                or pv.cost(current) > pv.cost(win.model):
             current, s = win.model, win.std
         label = {'friction': 'refit', 'law': win.h.label, 'plant': win.h.label}.get(win.h.kind, f'+ {win.h.effect}')
         step_notes = correction_notes(declared, current, s, est.theta is None) if win.h.kind == 'plant' else []
@@ -215,7 +216,7 @@ def undo_corrections(pe: Problem, pv: Problem, declared: Model, current: Model, 
             continue
         m, s2 = fit_model(pe, current.holding({name: declared[name]}), prior=declared)
         before, after = pv.summary(current)['x_rms_counts'], pv.summary(m)['x_rms_counts']
-        if after > before * (1 + WORSE_PERCENT / 100) or on_bounds(m):
+        if after > before * (1 + WORSE_PERCENT / 100) or on_bounds(m) or never_starts(pe.rec, m):
             continue
         note = (f'the data no longer move {name} from its declared {declared[name]:.4g} {p.unit} (the correction '
                 f'ended at {p.value:.4g} +/- {s:.2g} {p.unit}): held there again')

@@ -94,9 +94,11 @@ def identified(step: Step, dt: float) -> dict:
     normal force), plant_truth (every effect parameter, cogging phase included)."""
     m = step.model
     plant = m.plant_params()
+    truth = {k: v for k, v in m.plant_truth(dt).to_dict().items() if v and not k.startswith('noise')}
+    if not (truth.get('cogging_sin_N') or truth.get('cogging_cos_N')):
+        truth.pop('cogging_period_m', None)     # the period of no cogging: a default, not a finding
     return {'plant': {k: getattr(plant, k) for k in ('M', 'm', 'l', 'g', 'alpha', 'beta')},
-            'friction': m.friction_params().to_dict(), 'normal_force_N': m.normal_force,
-            'plant_truth': {k: v for k, v in m.plant_truth(dt).to_dict().items() if v and not k.startswith('noise')}}
+            'friction': m.friction_params().to_dict(), 'normal_force_N': m.normal_force, 'plant_truth': truth}
 
 
 MOVING = 0.005       # a speed above this moves the cart [m/s] (the speeds reported: of those samples)
@@ -256,9 +258,10 @@ def ladder_markdown(r: dict) -> str:
     idf = r['identified']
     lines += ['', '## Identified model (scenario sections)', '', '```yaml',
               f'plant: {json.dumps(idf["plant"])}', f'friction: {json.dumps(idf["friction"])}',
-              f'plant_truth: {json.dumps(idf["plant_truth"])}', '```', '',
-              'Figures: ladder.png (error at each step), windows.png (measured and simulated cart position '
-              'on validation windows, declared and final model).', '']
+              f'plant_truth: {json.dumps(idf["plant_truth"])}', '```', '']
+    if r.get('figures'):
+        lines += ['Figures: ladder.png (error at each step), windows.png (measured and simulated cart position '
+                  'on validation windows, declared and final model).', '']
     return '\n'.join(lines)
 
 

@@ -1,7 +1,8 @@
 """What refutes a fitted model besides its simulation error: what the record itself shows (its
 breakaways from rest, steady speeds, the lag of its response, a drive's crossings of its play, its rest
 angle) and contradicts, a parameter that ends on a bound of its range, and a size, a Coulomb level or a
-plant correction not told from zero or from the value it corrects."""
+plant correction not told from zero or from the value it corrects, a static friction that no command of
+the record could overcome."""
 from __future__ import annotations
 
 import math
@@ -9,6 +10,8 @@ import math
 import numpy as np
 
 from ..analysis.records import Record, smooth_rate
+from ..physics.friction import FP_ASYM, static_limit
+from ..physics.rig import input_effects
 from . import shooting
 from .effects import PARAMS, static_level
 from .model import Model
@@ -16,7 +19,7 @@ from .problem import Problem
 
 __all__ = ['SIZE', 'stops_and_starts', 'smallest_moving_command', 'steady_speeds', 'response_lag', 'drive_crossings',
            'contradictions', 'unresolved', 'near', 'uncorrected', 'rest_offset', 'no_static_level', 'bound_params',
-           'on_bounds', 'untold']
+           'on_bounds', 'untold', 'reversals', 'never_starts']
 
 UNDO_SIGMA = 2.0         # a correction that ends this many standard errors from the declared value or closer is undone
 STOP_S = 0.05            # a stretch this long with the encoder still is a stop [s]
@@ -220,3 +223,49 @@ def untold(model: Model, std: dict) -> list[str]:
         return [f'Fc = {model["Fc"]:.3g} +/- {s:.2g} N is not told from zero: a real cart slides against a '
                 f'Coulomb level; the model makes up for something else']
     return []
+
+
+def reversals(rec: Record, counts: int = 3) -> int:
+    """How often the cart reverses its travel: each reversal passes zero speed, and then the cart travels
+    the other way by ``counts`` encoder counts at least (the encoder's dither at rest is not one)."""
+    step = counts * rec.x_resolution
+    x = rec.x[rec.valid_mask]
+    d, ext, n = 0.0, float(x[0]) if len(x) else 0.0, 0
+    for v in x.tolist():
+        if d == 0.0:
+            if abs(v - ext) >= step:
+                d, ext = math.copysign(1.0, v - ext), v
+        elif (v - ext) * d > 0.0:
+            ext = v
+        elif (ext - v) * d >= step:
+            n, d, ext = n + 1, -d, v
+    return n
+
+
+def never_starts(rec: Record, model: Model) -> list[str]:
+    """Why ``model``'s cart could not start where the record's did: its static friction (eq. 5, the
+    weaker direction's limit (1 - |a|) mu_s F_N) holds the cart against the largest force the drive
+    gives at rest, alpha times the largest command through the model's deadzone and saturation, with the
+    track's forces (offset, cogging amplitude) added at their largest, while the record shows the cart
+    starting from rest (:func:`stops_and_starts`) or reversing its travel (:func:`reversals`: through
+    zero speed, where static friction holds too). A model that can never move the cart once it stops is
+    not the rig's, whatever its error on windows that start moving. Cart alone: a pendulum's swing
+    pushes the cart too."""
+    if rec.theta is not None:
+        return []
+    vec = model.vectors()
+    hold = (1.0 - abs(vec.fp[FP_ASYM])) * static_limit(vec.fp)
+    tr = vec.truth
+    volts = input_effects(float(np.max(np.abs(rec.u))), tr.deadzone_V, tr.saturation_V)
+    track = abs(model.get('offset_N')) + math.hypot(model.get('cogging_sin_N'), model.get('cogging_cos_N'))
+    push = model['alpha'] * volts + track
+    if hold <= push:
+        return []
+    starts, turns = len(stops_and_starts(rec)), reversals(rec)
+    if not starts + turns:
+        return []
+    seen = ' and '.join(w for w in (f'started from rest {starts} times' if starts else '',
+                                    f'reversed its travel {turns} times' if turns else '') if w)
+    return [f'static friction {hold:.4g} N holds the cart against every command of the record (at rest the drive '
+            f'gives at most {push:.4g} N: alpha {model["alpha"]:.4g} N/V times {volts:.4g} V'
+            + (f', the track {track:.3g} N' if track > 0.0 else '') + f'), yet the cart {seen}']

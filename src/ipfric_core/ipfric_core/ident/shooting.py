@@ -432,8 +432,10 @@ FLOOR_LEAD_S = 0.03
 
 
 def quantization_floor(model, rec: Record, win: Windows, key: str) -> dict:
-    """What a perfect model leaves on these windows: the error of ``key`` ('x' or 'theta') in counts and
-    in % of the motion when the data are ``model``'s own motion, read through the record's encoders.
+    """What a perfect model leaves on these windows: the error of ``key`` ('x' or 'theta') in counts when
+    the data are ``model``'s own motion, read through the record's encoders, and in % of the measured
+    motion (the denominator of :func:`summary`'s percent: a model that hardly moves the cart has a tiny
+    motion of its own, and its floor is not a share of that).
 
     Each window's motion is simulated from the measured state FLOOR_LEAD_S before its start, rounded to
     the encoder's grid (the cart's alone where the angle follows the measurement, both for the free
@@ -478,7 +480,8 @@ def quantization_floor(model, rec: Record, win: Windows, key: str) -> dict:
         e = e[np.isfinite(e)]
         sq += float(e @ e)
         n += len(e)
-        base = meas[start[again.window_of[c]]]
-        motion += float(np.sum(((meas[c] - base) / res) ** 2))
+        measured = rec.x if key == 'x' else rec.theta      # the motion of the data, as :func:`summary`'s
+        assert measured is not None
+        motion += float(np.sum(((measured[c] - measured[start[again.window_of[c]]]) / res) ** 2))
     rms = float(np.sqrt(sq / max(n, 1)))
     return {f'{key}_floor_counts': rms, f'{key}_floor_percent': float(100 * np.sqrt(sq) / max(np.sqrt(motion), 1.0))}

@@ -1,0 +1,50 @@
+"""What refutes a fitted model besides its error (ident/refutations.py), on records of the independent
+simulator (tests/independent/rigsim.py): a static friction that no command of the record overcomes."""
+from dataclasses import replace
+
+import numpy as np
+from independent import rigsim
+
+from ipfric_core.analysis.records import load
+from ipfric_core.ident.model import load_declared
+from ipfric_core.ident.refutations import never_starts, reversals, stops_and_starts
+
+
+def test_a_static_friction_no_command_overcomes_refutes_the_model(tmp_path):
+    rec = load(rigsim.write_case('cart_none', tmp_path, duration=20.0), None)
+    starts, turns = len(stops_and_starts(rec)), reversals(rec)
+    assert starts >= 3 and turns >= 3
+    model = load_declared(None, 'exponential', pendulum=False)
+    assert never_starts(rec, model) == []
+    umax = float(np.max(np.abs(rec.u)))
+    push = model['alpha'] * umax                         # the drive's largest force at rest [N]
+    at = {k: model.with_values({'Fs_excess': k * push - model['Fc']}) for k in (0.99, 1.01)}
+    assert never_starts(rec, at[0.99]) == []
+    why = never_starts(rec, at[1.01])
+    assert len(why) == 1, why
+    assert f'yet the cart started from rest {starts} times and reversed its travel {turns} times' in why[0]
+    assert f'at most {push:.4g} N' in why[0]
+    # a deadzone takes its width off the largest command: the same friction then holds the cart
+    dz = at[0.99].with_effect('deadzone', {'deadzone_V': 0.05 * umax})
+    assert never_starts(rec, dz) and f'times {0.95 * umax:.4g} V' in never_starts(rec, dz)[0]
+    # an offset pushes the cart at rest as the drive does
+    offset = at[1.01].with_effect('offset', {'offset_N': 0.05 * push})
+    assert never_starts(rec, offset) == []
+
+
+def test_a_pendulum_record_is_not_judged_so(tmp_path):
+    rec = load(rigsim.write_case('loop_none', tmp_path, duration=5.0), None)
+    model = load_declared(None, 'exponential', pendulum=True)
+    push = model['alpha'] * float(np.max(np.abs(rec.u)))
+    assert never_starts(rec, model.with_values({'Fs_excess': 2 * push})) == []
+
+
+def test_reversals_count_the_turns_of_travel_not_the_encoders_dither(tmp_path):
+    rec = load(rigsim.write_case('cart_none', tmp_path, duration=5.0), None)
+    q = rec.x_resolution
+    t = np.arange(4000) * 1e-3
+    wave = q * np.round(40 * np.sin(2 * np.pi * 2.0 * t))               # 2 Hz, 40 counts: 16 turns in 4 s
+    dither = q * (np.arange(4000) % 2)                                    # one count back and forth
+    assert reversals(replace(rec, t=t, x=wave, u=np.zeros(4000), valid=None)) == 16
+    assert reversals(replace(rec, t=t, x=wave + dither, u=np.zeros(4000), valid=None)) == 16
+    assert reversals(replace(rec, t=t, x=dither, u=np.zeros(4000), valid=None)) == 0
