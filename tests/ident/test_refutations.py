@@ -3,6 +3,7 @@ simulator (tests/independent/rigsim.py): a static friction that no command of th
 from dataclasses import replace
 
 import numpy as np
+import pytest
 from independent import rigsim
 
 from ipfric_core.analysis.records import load
@@ -30,6 +31,21 @@ def test_a_static_friction_no_command_overcomes_refutes_the_model(tmp_path):
     # an offset pushes the cart at rest as the drive does
     offset = at[1.01].with_effect('offset', {'offset_N': 0.05 * push})
     assert never_starts(rec, offset) == []
+    # a direction dependence lowers the limit one way: (1 - |a|) Fs is what holds the cart
+    assert never_starts(rec, at[1.01].with_effect('asymmetry', {'asymmetry': -0.05})) == []
+    # a drive play's contact pushes beyond alpha V: not judged so
+    assert never_starts(rec, at[1.01].with_effect('drive_backlash', {'drive_backlash_m': 1e-3})) == []
+
+
+@pytest.mark.parametrize('law', ['viscous', 'dynamic'])
+def test_laws_that_do_not_stick_are_not_judged_so(tmp_path, law):
+    """The viscous law has no static level; the dynamic law's bristles creep below it (the cart moves)."""
+    rec = load(rigsim.write_case('cart_none', tmp_path, duration=20.0), None)
+    model = load_declared(None, law, pendulum=False)
+    push = model['alpha'] * float(np.max(np.abs(rec.u)))
+    if 'Fs_excess' in {p.name for p in model.params}:
+        model = model.with_values({'Fs_excess': 2 * push})
+    assert never_starts(rec, model) == []
 
 
 def test_a_pendulum_record_is_not_judged_so(tmp_path):

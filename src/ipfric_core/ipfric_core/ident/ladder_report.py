@@ -259,9 +259,11 @@ def ladder_markdown(r: dict) -> str:
     lines += ['', '## Identified model (scenario sections)', '', '```yaml',
               f'plant: {json.dumps(idf["plant"])}', f'friction: {json.dumps(idf["friction"])}',
               f'plant_truth: {json.dumps(idf["plant_truth"])}', '```', '']
+    what = {'ladder.png': 'the error at each step', 'windows.png': 'measured and simulated cart position on '
+            'validation windows, declared and final model', 'test.png': 'the final model run free over the test record'}
     if r.get('figures'):
-        lines += ['Figures: ladder.png (error at each step), windows.png (measured and simulated cart position '
-                  'on validation windows, declared and final model).', '']
+        lines += ['Figures: ' + ', '.join(f'{Path(f).name} ({what.get(Path(f).name, "")})'.replace(' ()', '')
+                                          for f in r['figures']) + '.', '']
     return '\n'.join(lines)
 
 

@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from ..analysis.records import Record, smooth_rate
-from ..physics.friction import FP_ASYM, static_limit
+from ..physics.friction import FP_ASYM, static_limit, sticks
 from ..physics.rig import input_effects
 from . import shooting
 from .effects import PARAMS, static_level
@@ -233,11 +233,11 @@ def reversals(rec: Record, counts: int = 3) -> int:
     d, ext, n = 0.0, float(x[0]) if len(x) else 0.0, 0
     for v in x.tolist():
         if d == 0.0:
-            if abs(v - ext) >= step:
+            if abs(v - ext) >= step - 0.5 * rec.x_resolution:
                 d, ext = math.copysign(1.0, v - ext), v
         elif (v - ext) * d > 0.0:
             ext = v
-        elif (ext - v) * d >= step:
+        elif (ext - v) * d >= step - 0.5 * rec.x_resolution:      # whole counts, whatever the rounding
             n, d, ext = n + 1, -d, v
     return n
 
@@ -247,13 +247,15 @@ def never_starts(rec: Record, model: Model) -> list[str]:
     weaker direction's limit (1 - |a|) mu_s F_N) holds the cart against the largest force the drive
     gives at rest, alpha times the largest command through the model's deadzone and saturation, with the
     track's forces (offset, cogging amplitude) added at their largest, while the record shows the cart
-    starting from rest (:func:`stops_and_starts`) or reversing its travel (:func:`reversals`: through
-    zero speed, where static friction holds too). A model that can never move the cart once it stops is
-    not the rig's, whatever its error on windows that start moving. Cart alone: a pendulum's swing
-    pushes the cart too."""
-    if rec.theta is not None:
-        return []
+    starting from rest (:func:`stops_and_starts`, then travelling three counts) or reversing its travel
+    (:func:`reversals`: through zero speed, where static friction holds too). A model that can never move
+    the cart once it stops is not the rig's, whatever its error on windows that start moving. Only for
+    the laws that stick (coulomb, exponential: the dynamic law's bristles creep below the static level),
+    without a drive play (its contact's impacts push harder than the drive's force), on the cart alone (a
+    pendulum's swing pushes the cart too)."""
     vec = model.vectors()
+    if rec.theta is not None or not sticks(vec.fp) or 'drive_backlash' in model.effects:
+        return []
     hold = (1.0 - abs(vec.fp[FP_ASYM])) * static_limit(vec.fp)
     tr = vec.truth
     volts = input_effects(float(np.max(np.abs(rec.u))), tr.deadzone_V, tr.saturation_V)
@@ -261,7 +263,10 @@ def never_starts(rec: Record, model: Model) -> list[str]:
     push = model['alpha'] * volts + track
     if hold <= push:
         return []
-    starts, turns = len(stops_and_starts(rec)), reversals(rec)
+    travel = 2.5 * rec.x_resolution                        # three counts from the still reading
+    starts = sum(1 for still, _ in stops_and_starts(rec)
+                 if np.max(np.abs(rec.x[still:np.searchsorted(rec.t, rec.t[still] + 0.5)] - rec.x[still])) >= travel)
+    turns = reversals(rec)
     if not starts + turns:
         return []
     seen = ' and '.join(w for w in (f'started from rest {starts} times' if starts else '',
