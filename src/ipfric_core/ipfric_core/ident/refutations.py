@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from ..analysis.records import Record, smooth_rate
-from ..physics.friction import FP_ASYM, static_limit, sticks
+from ..physics.friction import holding_margin, static_limit, sticks
 from ..physics.rig import input_effects
 from . import shooting
 from .effects import PARAMS, static_level
@@ -243,10 +243,11 @@ def reversals(rec: Record, counts: int = 3) -> int:
 
 
 def never_starts(rec: Record, model: Model) -> list[str]:
-    """Why ``model``'s cart could not start where the record's did: its static friction (eq. 5, the
-    weaker direction's limit (1 - |a|) mu_s F_N) holds the cart against the largest force the drive
-    gives at rest, alpha times the largest command through the model's deadzone and saturation, with the
-    track's forces (offset, cogging amplitude) added at their largest, while the record shows the cart
+    """Why ``model``'s cart could not start where the record's did: its static friction (eq. 5 with the
+    direction dependence, :func:`~ipfric_core.physics.friction.holding_margin`) holds the cart both ways
+    against the largest force the drive gives at rest, alpha times the largest command through the
+    model's deadzone and saturation, with the track's forces (offset, cogging amplitude) added at their
+    largest, while the record shows the cart
     starting from rest (:func:`stops_and_starts`, then travelling three counts) or reversing its travel
     (:func:`reversals`: through zero speed, where static friction holds too). A model that can never move
     the cart once it stops is not the rig's, whatever its error on windows that start moving. Only for
@@ -256,12 +257,11 @@ def never_starts(rec: Record, model: Model) -> list[str]:
     vec = model.vectors()
     if rec.theta is not None or not sticks(vec.fp) or 'drive_backlash' in model.effects:
         return []
-    hold = (1.0 - abs(vec.fp[FP_ASYM])) * static_limit(vec.fp)
     tr = vec.truth
     volts = input_effects(float(np.max(np.abs(rec.u))), tr.deadzone_V, tr.saturation_V)
     track = abs(model.get('offset_N')) + math.hypot(model.get('cogging_sin_N'), model.get('cogging_cos_N'))
     push = model['alpha'] * volts + track
-    if hold <= push:
+    if holding_margin(vec.fp, push) >= 0.0 or holding_margin(vec.fp, -push) >= 0.0:    # eq. 5: it breaks away
         return []
     travel = 2.5 * rec.x_resolution                        # three counts from the still reading
     starts = sum(1 for still, _ in stops_and_starts(rec)
@@ -271,6 +271,7 @@ def never_starts(rec: Record, model: Model) -> list[str]:
         return []
     seen = ' and '.join(w for w in (f'started from rest {starts} times' if starts else '',
                                     f'reversed its travel {turns} times' if turns else '') if w)
-    return [f'static friction {hold:.4g} N holds the cart against every command of the record (at rest the drive '
+    return [f'static friction (up to {static_limit(vec.fp):.4g} N) holds the cart against every command of the '
+            f'record (at rest the drive '
             f'gives at most {push:.4g} N: alpha {model["alpha"]:.4g} N/V times {volts:.4g} V'
             + (f', the track {track:.3g} N' if track > 0.0 else '') + f'), yet the cart {seen}']
