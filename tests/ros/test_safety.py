@@ -244,3 +244,52 @@ def test_a_parameter_request_sent_as_the_run_ends_is_answered(tmp_path):
             sim.wait()
     answer = calls[0].result().results[0]
     assert not answer.successful and 'read-only' in answer.reason
+
+
+def test_the_sim_waits_for_the_recorder_on_each_of_its_topics(tmp_path):
+    """A recorder must get every message the simulator published: the simulator names the topic whose
+    subscription it waits for, starts once it matches, and at the end waits for the diagnostics to be
+    acknowledged as for its other topics (under load the last diagnostics were lost: 11 of 12
+    recorded)."""
+    import time
+
+    from diagnostic_msgs.msg import DiagnosticArray
+    from rosgraph_msgs.msg import Clock
+    from sensor_msgs.msg import JointState
+
+    from ipfric_msgs.msg import PlantState, SafetyEvent, VoltageCommand
+    cfg = scenario_file(tmp_path, 'fig7_old_gain_exponential.yaml', sim={'duration': 1.0, 'theta0': 0.0})
+    peer = Peer('fake_controller')
+    sim = None
+    try:
+        node = peer.node
+        cmd_pub = fake_controller(peer)
+        events, diagnostics = [], []
+
+        def on_joints(msg):
+            k = round(topics.stamp_to_ns(msg.header.stamp) / 1e6)
+            cmd_pub.publish(VoltageCommand(voltage=0.0, measurement_stamp=msg.header.stamp, sample_index=k))
+        node.create_subscription(JointState, topics.JOINT_STATES, on_joints, topics.data_qos())
+        node.create_subscription(JointState, topics.JOINT_STATES, lambda m: None, topics.data_qos())
+        node.create_subscription(PlantState, topics.PLANT_STATE, lambda m: None, topics.data_qos())
+        node.create_subscription(Clock, topics.CLOCK, lambda m: None, topics.data_qos())
+        node.create_subscription(SafetyEvent, topics.SAFETY_EVENT, events.append, topics.data_qos(100))
+        log = tmp_path / 'sim.log'
+        sim = start_node('sim_node', ['--params-file', str(cfg), '-p', 'start_timeout_s:=60.0',
+                                      '-p', 'controller_node:=/fake_controller'], peer.domain, log)
+        peer.spin_until(lambda: log.exists() and 'waiting for' in log.read_text(), 60, 'the wait to be logged')
+        waiting = [ln for ln in log.read_text().splitlines() if 'waiting for' in ln][-1]
+        assert f'/{topics.DIAGNOSTICS}: 0/1 subscribers' in waiting and 'joint_states' not in waiting, waiting
+        assert not events and 'START' not in log.read_text()
+        node.create_subscription(DiagnosticArray, topics.DIAGNOSTICS, diagnostics.append, topics.data_qos())
+        peer.spin_until(lambda: sim.poll() is not None, 60, 'the simulator to end')
+        t0 = time.monotonic()
+        while time.monotonic() - t0 < 1.0:
+            peer.executor.spin_once(timeout_sec=0.05)
+    finally:
+        peer.close()
+        if sim is not None and sim.poll() is None:
+            sim.kill()
+            sim.wait()
+    assert sim.returncode == 0 and [e.code for e in events][::len(events) - 1] == ['START', 'END'], events
+    assert [(d.header.stamp.sec, d.header.stamp.nanosec) for d in diagnostics] == [(1, 0)]   # sample 1000, the last

@@ -246,7 +246,8 @@ class SimNode(Node):
     # -- start -----------------------------------------------------------------------------
     def _missing_peers(self) -> list[str]:
         rec = 1 if self.wait_for_recorder else 0
-        need = [(self.pub_joints, 1 + rec), (self.pub_state, rec), (self.pub_clock, rec), (self.pub_event, rec)]
+        need = [(self.pub_joints, 1 + rec), (self.pub_state, rec), (self.pub_clock, rec), (self.pub_event, rec),
+                (self.pub_diagnostics, rec)]
         missing = [f'{pub.topic_name}: {pub.get_subscription_count()}/{n} subscribers'
                    for pub, n in need if pub.get_subscription_count() < n]
         if not self.controller.present():
@@ -488,7 +489,7 @@ class SimNode(Node):
         killed recorder) the others are not waited for.
         """
         deadline = time.monotonic() + timeout
-        for pub in (self.pub_event, self.pub_joints, self.pub_state, self.pub_clock):
+        for pub in (self.pub_event, self.pub_joints, self.pub_state, self.pub_clock, self.pub_diagnostics):
             while not pub.wait_for_all_acked(Duration(nanoseconds=ACK_SLICE_NS)):
                 self._executor.spin_once(timeout_sec=0.0)
                 if time.monotonic() > deadline:
