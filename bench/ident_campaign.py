@@ -35,11 +35,9 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT / 'tests') not in sys.path:
-    sys.path.insert(0, str(ROOT / 'tests'))
+from bench.independent_code import campaign
 
-from independent import campaign  # noqa: E402
+ROOT = Path(__file__).resolve().parents[1]
 
 FRICTION_PARTS = {'coulomb', 'stribeck', 'presliding'}
 OUTSIDE = set(campaign.OUTSIDE) | {'plant_error'}

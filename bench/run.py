@@ -311,10 +311,7 @@ def bench_identify(quick: bool) -> list[dict]:
             continue
         sim = None
         if args is None:
-            # imported as the tests and the campaign import it: numba's cache of its kernels names the module
-            if str(REPO_ROOT / 'tests') not in sys.path:
-                sys.path.insert(0, str(REPO_ROOT / 'tests'))
-            from independent import rigsim
+            from bench.independent_code import rigsim
             args = [str(rigsim.write_case('loop_cogging', out_dir, duration=120.0))]
             sim = simulation_time(Path(args[0]))
             row.update(reference=f'one simulation of the record\'s estimation part: {1e3 * sim:.3g} ms',

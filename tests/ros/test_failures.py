@@ -10,7 +10,7 @@ from rosrun import scenario_file, start_node, started
 
 from ipfric_core.analysis.bagread import read_run
 from ipfric_core.constants import REPO_ROOT as ROOT
-from ipfric_core.run.runner import Run, pick_domain
+from ipfric_core.run.runner import Run, claim_domain
 
 
 @pytest.mark.parametrize('node, changes, field', [
@@ -24,8 +24,12 @@ from ipfric_core.run.runner import Run, pick_domain
 ])
 def test_bad_parameter_stops_the_node_naming_the_field(tmp_path, node, changes, field):
     cfg = scenario_file(tmp_path, 'fig7_old_gain_exponential.yaml', **changes)
-    p = start_node(node, ['--params-file', str(cfg)], pick_domain(), tmp_path / f'{node}.log')
-    assert p.wait(timeout=60) == 2
+    lock = claim_domain()           # held: a run started beside it picks another
+    try:
+        p = start_node(node, ['--params-file', str(cfg)], lock.domain, tmp_path / f'{node}.log')
+        assert p.wait(timeout=60) == 2
+    finally:
+        lock.release()
     log = (tmp_path / f'{node}.log').read_text()
     assert '[FATAL]' in log and field in log, log
 
@@ -34,8 +38,12 @@ def test_unknown_parameter_is_named_with_a_suggestion(tmp_path):
     cfg = tmp_path / 'typo.yaml'
     cfg.write_text((ROOT / 'config' / 'fig7_old_gain_exponential.yaml').read_text()
                    .replace('    watchdog_samples:', '    watchdog_sample:'))
-    p = start_node('sim_node', ['--params-file', str(cfg)], pick_domain(), tmp_path / 'sim.log')
-    assert p.wait(timeout=60) == 2
+    lock = claim_domain()
+    try:
+        p = start_node('sim_node', ['--params-file', str(cfg)], lock.domain, tmp_path / 'sim.log')
+        assert p.wait(timeout=60) == 2
+    finally:
+        lock.release()
     log = (tmp_path / 'sim.log').read_text()
     assert "unknown parameter(s) 'watchdog_sample' (did you mean 'watchdog_samples'?)" in log, log
 
