@@ -5,7 +5,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import control
 import numpy as np
 
 from ..physics.params import Field, FrictionParams, PlantParams
@@ -59,6 +58,9 @@ def controllable_basis(A, B, rtol: float = 1e-9):
 
 def lqr_gain(A, B, Q, R) -> np.ndarray:
     """K (1 x n) minimizing int x'Qx + R V^2 dt, returned for V = +K x."""
+    # python-control is imported here only: importing it takes seconds (scipy.signal, matplotlib), and every
+    # ROS node imports this module (its scenario's LQR weights)
+    import control
     K, _, _ = control.lqr(np.asarray(A, float), np.asarray(B, float), np.asarray(Q, float),
                           np.atleast_2d(R))
     return -np.asarray(K, float).ravel()
