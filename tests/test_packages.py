@@ -233,6 +233,7 @@ def test_every_safety_event_code_has_its_constant():
     assert used <= set(EVENT_CODES) and {'STALL', 'INTRUDER', 'BAD_COMMAND', 'WATCHDOG'} <= used
 
 
+@pytest.mark.ros
 @pytest.mark.parametrize('module', ['ipfric_sim.sim_node', 'ipfric_controller.controller_node',
                                     'ipfric_record.recorder'])
 def test_the_nodes_start_without_the_slow_imports(module):

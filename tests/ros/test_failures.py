@@ -24,11 +24,14 @@ from ipfric_core.run.runner import Run, claim_domain
 ])
 def test_bad_parameter_stops_the_node_naming_the_field(tmp_path, node, changes, field):
     cfg = scenario_file(tmp_path, 'fig7_old_gain_exponential.yaml', **changes)
-    lock = claim_domain()           # held: a run started beside it picks another
+    lock, p = claim_domain(), None      # the domain held: a run started beside it picks another
     try:
         p = start_node(node, ['--params-file', str(cfg)], lock.domain, tmp_path / f'{node}.log')
         assert p.wait(timeout=60) == 2
     finally:
+        if p is not None and p.poll() is None:
+            p.kill()
+            p.wait()
         lock.release()
     log = (tmp_path / f'{node}.log').read_text()
     assert '[FATAL]' in log and field in log, log
@@ -38,11 +41,14 @@ def test_unknown_parameter_is_named_with_a_suggestion(tmp_path):
     cfg = tmp_path / 'typo.yaml'
     cfg.write_text((ROOT / 'config' / 'fig7_old_gain_exponential.yaml').read_text()
                    .replace('    watchdog_samples:', '    watchdog_sample:'))
-    lock = claim_domain()
+    lock, p = claim_domain(), None
     try:
         p = start_node('sim_node', ['--params-file', str(cfg)], lock.domain, tmp_path / 'sim.log')
         assert p.wait(timeout=60) == 2
     finally:
+        if p is not None and p.poll() is None:
+            p.kill()
+            p.wait()
         lock.release()
     log = (tmp_path / 'sim.log').read_text()
     assert "unknown parameter(s) 'watchdog_sample' (did you mean 'watchdog_samples'?)" in log, log
