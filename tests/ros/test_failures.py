@@ -86,7 +86,9 @@ def test_killed_controller_trips_the_watchdog_and_fails_the_run(tmp_path):
     assert bag.end_reason in ('FALLEN', 'TRACK_LIMIT'), codes   # 0 V held: the pendulum falls
     assert res.counts_match
     k_trip = [t for t, code, _ in bag.events if code == 'WATCHDOG'][0]
-    assert bag.command_t[-1] < k_trip     # no command after the controller died
+    # no command after the controller died: the last one answers the sample the watchdog trips at at most
+    # (sent as it was killed, it reached the simulator after the 2 s stall: a late answer, not applied; seen once)
+    assert bag.command_t[-1] <= k_trip
     # after the watchdog the rig applied 0 V
     after = bag.truth_t > k_trip + 1.5e-3
     assert (bag.truth['voltage_applied'][after] == 0.0).all()
