@@ -97,7 +97,7 @@ def test_undeclared_effect_in_independent_data(data, case, kept, expect):
         assert res['verdict']['explained'], res['verdict']     # down to what the encoders' rounding leaves
 
 
-@pytest.mark.slow
+@pytest.mark.long       # a minute; the default run finds a friction rising with speed on EMPS's real drive
 def test_a_friction_rising_with_speed_is_found_in_independent_data(tmp_path):
     """The independent simulator's track with a static level below the Coulomb one (mu_s 0.03, mu_c
     0.05, v_s 3 cm/s: a friction that rises with speed), cart alone, 45 s, declared as the paper's falling

@@ -13,6 +13,21 @@ from ipfric_core.constants import REPO_ROOT as ROOT
 from ipfric_core.run.runner import Run, claim_domain
 
 
+def refused(node: str, cfg, log) -> str:
+    """The log of ``node`` started on parameter file ``cfg`` in a ROS domain held meanwhile (a run started
+    beside it picks another); the node must exit with 2 within a minute (else it is killed)."""
+    lock, p = claim_domain(), None
+    try:
+        p = start_node(node, ['--params-file', str(cfg)], lock.domain, log)
+        assert p.wait(timeout=60) == 2
+    finally:
+        if p is not None and p.poll() is None:
+            p.kill()
+            p.wait()
+        lock.release()
+    return log.read_text()
+
+
 @pytest.mark.parametrize('node, changes, field', [
     ('sim_node', {'sim': {'friction.model': 'bristle'}},
      "sim_node.ros__parameters.friction.model: 'bristle' is not one of viscous, coulomb, exponential, dynamic"),
@@ -24,16 +39,7 @@ from ipfric_core.run.runner import Run, claim_domain
 ])
 def test_bad_parameter_stops_the_node_naming_the_field(tmp_path, node, changes, field):
     cfg = scenario_file(tmp_path, 'fig7_old_gain_exponential.yaml', **changes)
-    lock, p = claim_domain(), None      # the domain held: a run started beside it picks another
-    try:
-        p = start_node(node, ['--params-file', str(cfg)], lock.domain, tmp_path / f'{node}.log')
-        assert p.wait(timeout=60) == 2
-    finally:
-        if p is not None and p.poll() is None:
-            p.kill()
-            p.wait()
-        lock.release()
-    log = (tmp_path / f'{node}.log').read_text()
+    log = refused(node, cfg, tmp_path / f'{node}.log')
     assert '[FATAL]' in log and field in log, log
 
 
@@ -41,16 +47,7 @@ def test_unknown_parameter_is_named_with_a_suggestion(tmp_path):
     cfg = tmp_path / 'typo.yaml'
     cfg.write_text((ROOT / 'config' / 'fig7_old_gain_exponential.yaml').read_text()
                    .replace('    watchdog_samples:', '    watchdog_sample:'))
-    lock, p = claim_domain(), None
-    try:
-        p = start_node('sim_node', ['--params-file', str(cfg)], lock.domain, tmp_path / 'sim.log')
-        assert p.wait(timeout=60) == 2
-    finally:
-        if p is not None and p.poll() is None:
-            p.kill()
-            p.wait()
-        lock.release()
-    log = (tmp_path / 'sim.log').read_text()
+    log = refused('sim_node', cfg, tmp_path / 'sim.log')
     assert "unknown parameter(s) 'watchdog_sample' (did you mean 'watchdog_samples'?)" in log, log
 
 
