@@ -152,6 +152,8 @@ def test_cli_csv_report_and_export(tmp_path, clean, capsys):
     assert r['effects_added'] == []
     for name in ('report.md', 'ladder.png', 'windows.png'):
         assert (tmp_path / 'rep' / name).stat().st_size > 0
+    assert 'Figures: ladder.png (the error at each step), windows.png (measured and simulated cart position' \
+        in (tmp_path / 'rep' / 'report.md').read_text()      # the figures drawn, each said once
     sc = load_scenario(tmp_path / 'identified.yaml')
     assert sc.friction.mu_c == pytest.approx(TRACK.mu_c, rel=0.05)
     assert main(['identify', str(csv), '--effects', 'friction_wobble', '--out', str(tmp_path)]) == 2

@@ -319,6 +319,7 @@ def test_the_end_waits_for_every_published_topic_to_be_acknowledged():
         _executor = Executor()
         pub_event, pub_joints, pub_state, pub_clock = (Publisher(f'/{n}', 1) for n in ('e', 'j', 's', 'c'))
         pub_diagnostics = Publisher('/diagnostics', 3)      # acknowledged on the third wait
+        recorded_publishers = SimNode.recorded_publishers
 
         def get_logger(self):
             raise AssertionError('a timeout was logged')

@@ -244,10 +244,15 @@ class SimNode(Node):
         self.intruders = {t: n for t, n in self.intruders.items() if n}
 
     # -- start -----------------------------------------------------------------------------
+    @property
+    def recorded_publishers(self) -> tuple:
+        """The publishers of the topics a run's recorder records: it is waited for on each before sample 0,
+        and each one's messages acknowledged at the end (:meth:`flush_end`)."""
+        return self.pub_event, self.pub_joints, self.pub_state, self.pub_clock, self.pub_diagnostics
+
     def _missing_peers(self) -> list[str]:
         rec = 1 if self.wait_for_recorder else 0
-        need = [(self.pub_joints, 1 + rec), (self.pub_state, rec), (self.pub_clock, rec), (self.pub_event, rec),
-                (self.pub_diagnostics, rec)]
+        need = [(pub, rec + (pub is self.pub_joints)) for pub in self.recorded_publishers]   # and the controller
         missing = [f'{pub.topic_name}: {pub.get_subscription_count()}/{n} subscribers'
                    for pub, n in need if pub.get_subscription_count() < n]
         if not self.controller.present():
@@ -489,7 +494,7 @@ class SimNode(Node):
         killed recorder) the others are not waited for.
         """
         deadline = time.monotonic() + timeout
-        for pub in (self.pub_event, self.pub_joints, self.pub_state, self.pub_clock, self.pub_diagnostics):
+        for pub in self.recorded_publishers:
             while not pub.wait_for_all_acked(Duration(nanoseconds=ACK_SLICE_NS)):
                 self._executor.spin_once(timeout_sec=0.0)
                 if time.monotonic() > deadline:

@@ -262,8 +262,8 @@ def ladder_markdown(r: dict) -> str:
     what = {'ladder.png': 'the error at each step', 'windows.png': 'measured and simulated cart position on '
             'validation windows, declared and final model', 'test.png': 'the final model run free over the test record'}
     if r.get('figures'):
-        lines += ['Figures: ' + ', '.join(f'{Path(f).name} ({what.get(Path(f).name, "")})'.replace(' ()', '')
-                                          for f in r['figures']) + '.', '']
+        names = [Path(f).name for f in r['figures']]
+        lines += ['Figures: ' + ', '.join(f'{n} ({what[n]})' if n in what else n for n in names) + '.', '']
     return '\n'.join(lines)
 
 
