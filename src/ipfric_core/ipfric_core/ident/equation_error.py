@@ -56,6 +56,9 @@ class Prepared:
         self.idx = np.arange(0, n, self.q)
         self.dt = dt * self.q
         self.t_full = t
+        steps = np.diff(t)
+        #: a uniform grid of the median period where the stamps are uneven (None where they are even)
+        self.grid = np.arange(t[0], t[-1], dt) if np.max(steps) > 1.5 * np.min(steps) + 1e-9 else None
         # the command u_k is held over [t_k, t_k+1): at t_k the force is the mean of u_k-1 and u_k
         self.u_full = np.concatenate([[rec.u[0]], 0.5 * (rec.u[1:] + rec.u[:-1])])
         self.t = t[self.idx]
@@ -66,7 +69,7 @@ class Prepared:
         self.has_theta = rec.theta is not None
         if self.has_theta:
             self.th, self.thd, self.thdd = self._derivatives(rec.theta)
-        self.uf_full = sosfiltfilt(self.sos, self.u_full)
+        self.uf_full = self.smooth(self.u_full)
         self.uf = self.uf_full[self.idx]
         self._breakaways(rec)
         self.inside = (self.t >= t[0] + EDGE_S) & (self.t <= t[-1] - EDGE_S)
@@ -101,8 +104,8 @@ class Prepared:
         self.b_kind = np.array(kind)
         self.b_x = rec.x[self.b_idx]
         if rec.theta is not None:
-            f = sosfiltfilt(self.sos, rec.theta)
-            self.b_th, self.b_thd = f[self.b_idx], np.gradient(f, t)[self.b_idx]
+            f, v, _ = self.smooth_derivatives(rec.theta)
+            self.b_th, self.b_thd = f[self.b_idx], v[self.b_idx]
 
     def near(self, stuck: np.ndarray) -> np.ndarray:
         """``stuck`` widened by one corner period each side (the filter spreads a stick-slip
@@ -112,11 +115,26 @@ class Prepared:
             return stuck
         return np.convolve(stuck.astype(float), np.ones(2 * k + 1), 'same') > 0
 
+    def smooth(self, y: np.ndarray) -> np.ndarray:
+        """``y`` (one value a stamp) low-passed without phase, at the stamps (:meth:`smooth_derivatives`)."""
+        return self.smooth_derivatives(y, derivatives=False)[0]
+
+    def smooth_derivatives(self, y: np.ndarray, derivatives: bool = True) -> tuple:
+        """``y`` low-passed without phase and its first two time derivatives, at the stamps. Where the
+        stamps are uneven, through the uniform :attr:`grid` (``y`` read off it linearly): a filter run over
+        uneven samples as if they were even, then differenced over the true stamps, made the derivatives
+        noise (a cart logged at 1.3-12.6 ms, median 3.6 ms: its force balance left 9 N RMS against a drive
+        force of 2 N)."""
+        t, g = self.rec.t, self.grid
+        f = sosfiltfilt(self.sos, y if g is None else np.interp(g, t, y))
+        at = t if g is None else g
+        out = [f] + ([np.gradient(f, at)] if derivatives else [])
+        if derivatives:
+            out.append(np.gradient(out[1], at))
+        return tuple(s if g is None else np.interp(t, g, s) for s in out)
+
     def _derivatives(self, y):
-        f = sosfiltfilt(self.sos, y)
-        v = np.gradient(f, self.rec.t)
-        a = np.gradient(v, self.rec.t)
-        return f[self.idx], v[self.idx], a[self.idx]
+        return tuple(s[self.idx] for s in self.smooth_derivatives(y))
 
 
 @dataclass
@@ -139,7 +157,7 @@ def balance(pr: Prepared, p: dict, active) -> Balance:
     rec = pr.rec
     if any(fx.EFFECTS[e].acts_on == 'input' for e in active):
         u = fx.effective_input(pr.t_full, pr.u_full, p, active)
-        uf_full = sosfiltfilt(pr.sos, u)
+        uf_full = pr.smooth(u)
     else:
         uf_full = pr.uf_full
     uf = uf_full[pr.idx]
