@@ -64,3 +64,19 @@ def test_reversals_count_the_turns_of_travel_not_the_encoders_dither(tmp_path):
     assert reversals(replace(rec, t=t, x=wave, u=np.zeros(4000), valid=None)) == 16
     assert reversals(replace(rec, t=t, x=wave + dither, u=np.zeros(4000), valid=None)) == 16
     assert reversals(replace(rec, t=t, x=dither, u=np.zeros(4000), valid=None)) == 0
+
+
+def test_a_cogging_must_repeat_over_the_travel(tmp_path):
+    """A ripple is a force that repeats: a cogging whose period fits twice into the cart's travel stands (a
+    balancing loop's cart travels some 30 mm: seed 2027's case 199 holds a 14 mm cogging of 2.5 counts), one
+    that does not is refuted by the travel, whatever its fit."""
+    from ipfric_core.ident.problem import Problem
+    from ipfric_core.ident.refutations import contradictions
+    rec = load(rigsim.write_case('loop_none', tmp_path, duration=10.0), None)
+    travel = float(np.ptp(rec.x))
+    model = load_declared(None, 'exponential', pendulum=True).with_effect('cogging', {'cogging_sin_N': 0.01})
+    pr = Problem(rec)
+    assert contradictions(pr, model.with_values({'cogging_period_m': 0.49 * travel}), 'cogging') == []
+    why = contradictions(pr, model.with_values({'cogging_period_m': 0.51 * travel}), 'cogging')
+    assert why == [f'cogging period {0.51 * travel * 1e3:.3g} mm: fewer than 2 periods over the travel '
+                   f'({travel * 1e3:.3g} mm)']

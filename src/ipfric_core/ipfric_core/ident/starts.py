@@ -14,7 +14,7 @@ from ..physics.params import ConfigError
 from .effects import PARAMS
 from .model import FRICTION_FITTED, LAW_PARAMS, Model
 from .problem import Problem
-from .refutations import response_lag, rest_offset, smallest_moving_command
+from .refutations import RIPPLE_PERIODS, response_lag, rest_offset, smallest_moving_command
 
 __all__ = ['DRIVE_GRID', 'effect_starts', 'ripple_starts', 'drive_starts', 'law_starts', 'stribeck_starts',
            'peak_level', 'bristle_starts', 'balance_starts', 'contact_damping']
@@ -46,7 +46,7 @@ def effect_starts(pr: Problem, model: Model, name: str, prior: Model) -> list[di
     return [{}]
 
 
-#: the cogging periods [m] :func:`ripple_starts` looks for (three of them at least over the travel)
+#: the cogging periods [m] :func:`ripple_starts` looks for (RIPPLE_PERIODS of them at least over the travel)
 RIPPLE_RANGE = (0.0015, 0.03)
 #: its periodogram's frequencies per peak width (a peak is 1 / travel wide in 1/m: a period 2.6 % off over
 #: 20 periods of travel drifts by half a period; from a fixed grid's points 5 % apart a 7.74 mm cogging
@@ -75,7 +75,7 @@ def ripple_starts(rec: Record, model: Model, keep: int = 2) -> list[dict]:
         return []
 
     travel = float(np.ptp(x))
-    lo, hi = 2 * np.pi * max(1 / RIPPLE_RANGE[1], 3 / max(travel, 1e-12)), 2 * np.pi / RIPPLE_RANGE[0]
+    lo, hi = 2 * np.pi * max(1 / RIPPLE_RANGE[1], RIPPLE_PERIODS / max(travel, 1e-12)), 2 * np.pi / RIPPLE_RANGE[0]
     if lo >= hi:
         return []
     omega = np.arange(lo, hi, 2 * np.pi / (RIPPLE_OVERSAMPLE * travel))
