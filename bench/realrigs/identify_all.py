@@ -26,16 +26,19 @@ HEADER = ('| rig / log | exit | wall s | kept (effects, corrections, law) | verd
 
 
 def identify(csv: Path, out: Path) -> dict:
-    """Run ``./ipfric identify`` on one log (in this process's environment, as the campaign does: the code
-    on its path, a worktree's included); its exit code, wall time and the reason of a refusal."""
+    """Run ``python -m ipfric_core.cli identify`` (``./ipfric identify``) on one log with this process's
+    Python and environment, as the campaign does (the ipfric_core on its path: a worktree's where PYTHONPATH
+    names it), on one thread; its exit code, wall time and the reason of a refusal."""
     with csv.open() as f:
         cart_alone = 'theta' not in f.readline().strip().split(',')
     args = ['identify', str(csv), '--plant', str(csv.parent / 'plant.yaml'), '--out', str(out),
             '--no-plots', '--json'] + (['--cart-alone'] if cart_alone else [])
     t0 = time.perf_counter()
     proc = subprocess.run([sys.executable, '-m', 'ipfric_core.cli', *args], cwd=ROOT,
-                          env=dict(os.environ, NUMBA_NUM_THREADS='1'), capture_output=True, text=True)
-    run = dict(exit=proc.returncode, wall_s=round(time.perf_counter() - t0, 1), command='./ipfric ' + ' '.join(args))
+                          env=dict(os.environ, NUMBA_NUM_THREADS='1', OPENBLAS_NUM_THREADS='1', MKL_NUM_THREADS='1'),
+                          capture_output=True, text=True)
+    run = dict(exit=proc.returncode, wall_s=round(time.perf_counter() - t0, 1),
+               command='python -m ipfric_core.cli ' + ' '.join(args))
     errors = [ln.split('error: ', 1)[1] for ln in proc.stderr.splitlines() if 'error: ' in ln]
     if proc.returncode:
         run['error'] = (errors[-1] if errors else proc.stderr.strip()[-300:]).replace(f'{csv.parent}/', '')

@@ -167,7 +167,7 @@ def test_a_small_cogging_is_fitted_from_the_phase_its_replay_prefers(tmp_path, a
     replay prefers (``starts.phased``) the fit reaches the truth's error, within 0.1 % of its period, 20 % of
     its size and 25 degrees of its phase."""
     from ipfric_core.ident.problem import Problem, fit_model
-    from ipfric_core.ident.starts import phased, ripple_starts
+    from ipfric_core.ident.starts import ripple_starts
     spec = dict(rigsim.CASES['cart_cogging'], size={'amplitude_N': amplitude, 'period_m': period, 'phase_rad': phase})
     rec = load(rigsim.write_case('cart_small_cogging', tmp_path, data=rigsim.simulate(spec)), None, cart_alone=True)
     est, _ = rec.split(0.6)
@@ -177,7 +177,7 @@ def test_a_small_cogging_is_fitted_from_the_phase_its_replay_prefers(tmp_path, a
     base = declared.with_effect('cogging').with_free(('cogging_sin_N', 'cogging_cos_N', 'cogging_period_m') + law)
     truth = base.with_values({'cogging_period_m': period, 'cogging_sin_N': amplitude * math.cos(phase),
                               'cogging_cos_N': amplitude * math.sin(phase)})
-    start = phased(pe, declared, ripple_starts(est, declared)[0])
+    start = ripple_starts(est, declared, replay=pe)[0]
     fit = fit_model(pe, base.with_values(start), max_nfev=40, prior=declared, errors=False)[0]
     assert pe.cost(fit) <= 1.02 * pe.cost(truth)
     assert fit['cogging_period_m'] == pytest.approx(period, rel=1e-3)

@@ -29,10 +29,13 @@ from scipy.signal import butter, sosfiltfilt
 
 from ..physics.params import ConfigError, PlantParams
 
-__all__ = ['Record', 'smallest_step', 'smooth_rate', 'angle_equation', 'upright_angle', 'frozen_tail', 'gap_starts',
+__all__ = ['Record', 'smallest_step', 'uneven', 'filtered_on_grid', 'smooth_rate', 'angle_equation', 'upright_angle',
+           'frozen_tail', 'gap_starts',
            'ANGLE_ZEROS', 'is_log', 'parse_columns', 'load', 'trajectory_record']
 
 MIN_SAMPLES = 200
+#: stamps whose longest period is more than this many times their shortest are uneven
+UNEVEN_RATIO = 1.5
 MIN_PART_COUNTS = 100   # encoder counts an estimation or validation part must move at least
 MAX_ROWS = 2_000_000    # a longer CSV is refused (33 min at 1 kHz; identification would take hours)
 MAX_VOLTAGE = 100.0     # |u| beyond this is not a drive command [V] (lab drives give 5-48 V)
@@ -136,16 +139,32 @@ def smallest_step(y, still: float = 1.0) -> float:
     return float(steps.min()) if len(steps) else still
 
 
-def smooth_rate(t: np.ndarray, y: np.ndarray, valid: np.ndarray | None = None,
-                cutoff_hz: float = RATE_HZ) -> np.ndarray:
-    """dy/dt of a sampled signal [unit/s]: zero-phase 4th-order Butterworth at ``cutoff_hz`` on a uniform
-    grid (the record's median period; ``valid`` samples only), differentiated, read back at ``t``."""
+def uneven(t: np.ndarray) -> bool:
+    """True where the periods between the stamps ``t`` [s] range over more than UNEVEN_RATIO (jitter, overruns)."""
+    d = np.diff(t)
+    return bool(np.max(d) > UNEVEN_RATIO * np.min(d) + 1e-9)
+
+
+def filtered_on_grid(t: np.ndarray, y: np.ndarray, sos: np.ndarray, valid: np.ndarray | None = None,
+                     derivatives: int = 0) -> list[np.ndarray]:
+    """``y`` through the zero-phase filter ``sos`` (designed at the median period of the stamps ``t`` [s]) on a
+    uniform grid of that period, the ``valid`` samples read off linearly, and its first ``derivatives`` time
+    derivatives [unit/s^k], each read back at ``t``."""
     valid = np.ones(len(t), bool) if valid is None else valid
     dt = float(np.median(np.diff(t)))
     grid = np.arange(t[0], t[-1] + 0.5 * dt, dt)
-    yg = np.interp(grid, t[valid], y[valid])
-    f = sosfiltfilt(butter(4, min(cutoff_hz, 0.4 / dt), fs=1.0 / dt, output='sos'), yg)
-    return np.interp(t, grid, np.gradient(f, dt))
+    out = [sosfiltfilt(sos, np.interp(grid, t[valid], y[valid]))]
+    for _ in range(derivatives):
+        out.append(np.gradient(out[-1], dt))
+    return [np.interp(t, grid, s) for s in out]
+
+
+def smooth_rate(t: np.ndarray, y: np.ndarray, valid: np.ndarray | None = None,
+                cutoff_hz: float = RATE_HZ) -> np.ndarray:
+    """dy/dt of a sampled signal [unit/s]: zero-phase 4th-order Butterworth at ``cutoff_hz`` on a uniform
+    grid (:func:`filtered_on_grid`: the record's median period; ``valid`` samples only)."""
+    dt = float(np.median(np.diff(t)))
+    return filtered_on_grid(t, y, butter(4, min(cutoff_hz, 0.4 / dt), fs=1.0 / dt, output='sos'), valid, 1)[1]
 
 
 def overruns(t: np.ndarray, readings: list) -> np.ndarray:
@@ -378,7 +397,7 @@ def check_record(rec: Record, angle_zero: str = 'auto') -> Record:
     if not valid.all():
         notes.append(f'{int((~valid).sum())} stale readings after {int(np.sum(np.diff(valid.astype(int)) == -1))} '
                      f'sample overruns (stamp jump, encoders frozen): not compared')
-    if np.max(d) > 1.5 * np.min(d) + 1e-9:
+    if uneven(rec.t):
         notes.append(f'uneven stamps (period {np.min(d):g} to {np.max(d):g} s, median {period:g} s): '
                      f'each command held until the next stamp')
     return replace(rec, theta=theta, valid=valid, notes=tuple(notes))

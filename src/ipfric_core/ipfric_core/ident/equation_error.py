@@ -27,7 +27,7 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.signal import butter, sosfiltfilt
 
-from ..analysis.records import Record
+from ..analysis.records import Record, filtered_on_grid, uneven
 from ..physics.params import ConfigError
 from ..physics.plant import held_forces, pendulum_residuals, required_forces
 from . import effects as fx
@@ -56,9 +56,8 @@ class Prepared:
         self.idx = np.arange(0, n, self.q)
         self.dt = dt * self.q
         self.t_full = t
-        steps = np.diff(t)
-        #: a uniform grid of the median period where the stamps are uneven (None where they are even)
-        self.grid = np.arange(t[0], t[-1], dt) if np.max(steps) > 1.5 * np.min(steps) + 1e-9 else None
+        #: the stamps are uneven: signals are filtered on a uniform grid (:meth:`smooth_derivatives`)
+        self.uneven = uneven(t)
         # the command u_k is held over [t_k, t_k+1): at t_k the force is the mean of u_k-1 and u_k
         self.u_full = np.concatenate([[rec.u[0]], 0.5 * (rec.u[1:] + rec.u[:-1])])
         self.t = t[self.idx]
@@ -104,7 +103,7 @@ class Prepared:
         self.b_kind = np.array(kind)
         self.b_x = rec.x[self.b_idx]
         if rec.theta is not None:
-            f, v, _ = self.smooth_derivatives(rec.theta)
+            f, v = self.smooth_derivatives(rec.theta, rec.valid_mask, 1)
             self.b_th, self.b_thd = f[self.b_idx], v[self.b_idx]
 
     def near(self, stuck: np.ndarray) -> np.ndarray:
@@ -116,25 +115,25 @@ class Prepared:
         return np.convolve(stuck.astype(float), np.ones(2 * k + 1), 'same') > 0
 
     def smooth(self, y: np.ndarray) -> np.ndarray:
-        """``y`` (one value a stamp) low-passed without phase, at the stamps (:meth:`smooth_derivatives`)."""
-        return self.smooth_derivatives(y, derivatives=False)[0]
+        """``y`` (a command: every sample valid) low-passed without phase, at the stamps
+        (:meth:`smooth_derivatives`)."""
+        return self.smooth_derivatives(y, None, 0)[0]
 
-    def smooth_derivatives(self, y: np.ndarray, derivatives: bool = True) -> tuple:
-        """``y`` low-passed without phase and its first two time derivatives, at the stamps. Where the
-        stamps are uneven, through the uniform :attr:`grid` (``y`` read off it linearly): a filter run over
-        uneven samples as if they were even, then differenced over the true stamps, made the derivatives
-        noise (a cart logged at 1.3-12.6 ms, median 3.6 ms: its force balance left 9 N RMS against a drive
-        force of 2 N)."""
-        t, g = self.rec.t, self.grid
-        f = sosfiltfilt(self.sos, y if g is None else np.interp(g, t, y))
-        at = t if g is None else g
-        out = [f] + ([np.gradient(f, at)] if derivatives else [])
-        if derivatives:
-            out.append(np.gradient(out[1], at))
-        return tuple(s if g is None else np.interp(t, g, s) for s in out)
+    def smooth_derivatives(self, y: np.ndarray, valid: np.ndarray | None, derivatives: int) -> list[np.ndarray]:
+        """``y`` low-passed without phase and its first ``derivatives`` time derivatives [unit/s^k], at the
+        stamps. Where they are uneven, on a uniform grid of the median period, its ``valid`` samples read off
+        linearly (:func:`~ipfric_core.analysis.records.filtered_on_grid`): a filter run over uneven samples as
+        if they were even, then differenced over the true stamps, made the derivatives noise (a cart logged
+        at 1.3-12.6 ms, median 3.6 ms: its force balance left 9 N RMS against a drive force of 2 N)."""
+        if self.uneven:
+            return filtered_on_grid(self.rec.t, y, self.sos, valid, derivatives)
+        out = [sosfiltfilt(self.sos, y)]
+        for _ in range(derivatives):
+            out.append(np.gradient(out[-1], self.rec.t))
+        return out
 
     def _derivatives(self, y):
-        return tuple(s[self.idx] for s in self.smooth_derivatives(y))
+        return tuple(s[self.idx] for s in self.smooth_derivatives(y, self.rec.valid_mask, 2))
 
 
 @dataclass

@@ -31,7 +31,8 @@ from .starts import (
     stribeck_starts,
 )
 
-__all__ = ['LAWS', 'PLANT_CORRECTIONS', 'Hypothesis', 'hypotheses', 'in_place_of_mass', 'short_fit', 'short_fits',
+__all__ = ['refit_of', 'LAWS', 'PLANT_CORRECTIONS', 'Hypothesis', 'hypotheses', 'in_place_of_mass', 'short_fit',
+           'short_fits',
            'joint', 'full_fit', 'contact_held', 'errors_of', 'screen']
 
 #: the friction laws the ladder weighs against each other
@@ -79,6 +80,12 @@ class Hypothesis:
     screened: bool = True
 
 
+def refit_of(current: Model, starts: list | None = None) -> Hypothesis:
+    """The hypothesis that ``current``'s friction levels (its law's) are off: they are refitted."""
+    law = LAW_PARAMS[current.law]
+    return Hypothesis('refit', 'friction', current.with_free(law), law, law, starts or [{}])
+
+
 def hypotheses(pe: Problem, current: Model, declared: Model, allowed=None, balance: dict | None = None
                ) -> list[Hypothesis]:
     """The explanations a round tries against ``current`` (see :class:`Hypothesis`): the declared law
@@ -94,8 +101,8 @@ def hypotheses(pe: Problem, current: Model, declared: Model, allowed=None, balan
     balance = balance or {}
     out = []
     if not refitted:
-        out.append(Hypothesis('refit', 'friction', current.with_free(law), law, law,
-                              [{}] + stribeck_starts(current) + ([balance['refit']] if 'refit' in balance else [])))
+        out.append(refit_of(current, [{}] + stribeck_starts(current)
+                            + ([balance['refit']] if 'refit' in balance else [])))
     for other in LAWS:
         if other != current.law:
             m = current.with_law(other, law_starts(declared))

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 from ..analysis.records import Record
 from .effects import PARAMS
-from .hypotheses import PLANT_CORRECTIONS, Hypothesis, errors_of, full_fit, hypotheses, screen, short_fits
+from .hypotheses import PLANT_CORRECTIONS, Hypothesis, errors_of, full_fit, hypotheses, refit_of, screen, short_fits
 from .judging import WORSE_PERCENT, Judged, beyond_refit, contribution, judge, leaner_first, verdict
 from .model import FRICTION_FITTED, LAW_PARAMS, Model
 from .problem import Problem, fit_model
@@ -41,31 +41,34 @@ CONTRIBUTION_COUNTS = 2.0  # a kept hypothesis changes the simulated motion by t
 REFIT_NOTE = 0.3         # a refit that moves a declared value by more than 30 % is reported
 
 
-def confirm(pe: Problem, pv: Problem, current: Model, j: Judged, prior: Model) -> None:
+def confirm(pe: Problem, pv: Problem, current: Model, j: Judged, prior: Model) -> bool:
     """The checks of a hypothesis that passed :func:`judge` which need its standard errors (its size told
     from zero, a plant correction told from the value it corrects, a Coulomb level told from zero) and its
-    contribution to the simulated motion; the reasons it fails them are added to ``j.refused``."""
+    contribution to the simulated motion; the reasons it fails them are added to ``j.refused``. True where
+    the one reason is a plant correction not told from the value it corrects (:func:`as_refit`)."""
     j.std = errors_of(pe, j.h, j.model, prior)
     why = untold(j.model, j.std) + (unresolved(j.model, j.std, j.h.effect) if j.h.effect else [])
-    if j.h.kind == 'plant':
-        why += uncorrected(j.model, j.std, current, j.h.own)
+    corrected = uncorrected(j.model, j.std, current, j.h.own) if j.h.kind == 'plant' else []
+    why += corrected
     if not why:
         size = contribution((pe, pv), j.model, undone(j, current))
         if size < CONTRIBUTION_COUNTS:
             why.append(f'it changes the simulated motion by {size:.2g} counts RMS (needs {CONTRIBUTION_COUNTS:g}: '
                        f'too small to matter at the encoders)')
     j.refused += why
+    return bool(corrected) and why == corrected
 
 
 def as_refit(pe: Problem, pv: Problem, current: Model, j: Judged, prior: Model, sse0_v) -> Judged:
-    """A plant correction refused only as not told from the value it corrects (:func:`uncorrected`) whose fit
+    """A plant correction refused only as not told from the value it corrects (:func:`confirm`) whose fit
     still passes: the friction its fit found is ``current``'s own, refitted from another start. That model
-    with the constant held at its value in ``current`` and the rest fitted again, judged as a refit of
-    ``current`` (a saturation fitted beside the refit ended with the viscous slope near 0 at 271 counts;
-    a mass 'corrected' by 0.04 %, started from the force balance, left 3.0)."""
-    law = LAW_PARAMS[current.law]
-    m = fit_model(pe, j.model.holding({n: current[n] for n in j.h.own}), prior=prior, errors=False)[0]
-    h = Hypothesis('refit', 'friction', current.with_free(law), law, law)
+    with the constant held at its value in ``current``, fitted as the round's refit is (:func:`full_fit`)
+    and judged as a refit of ``current``, in the correction's place among the round's candidates (the two
+    differ by a constant the data do not tell from its value). A saturation fitted beside the refit had
+    ended with the viscous slope near 0 at 271 counts; a mass 'corrected' by 0.04 %, started from the force
+    balance, left 3.0 (seed 2027, case 25)."""
+    h = refit_of(current)
+    m = full_fit(pe, h, j.model.holding({n: current[n] for n in j.h.own}), prior)
     return judge(pe, pv, current, h, m, None, sse0_v)
 
 
@@ -162,9 +165,7 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
         passing = leaner_first(sorted((j for j in judged if not j.refused), key=lambda j: j.score), pv)
         ok = []
         for j in passing:            # the standard errors of the best ones, until two pass
-            confirm(pe, pv, current, j, declared)
-            if (j.refused and j.refused == uncorrected(j.model, j.std, current, j.h.own)
-                    and not any(k.h.kind == 'friction' for k in judged)):
+            if confirm(pe, pv, current, j, declared) and not any(k.h.kind == 'friction' for k in judged):
                 j = as_refit(pe, pv, current, j, declared, sse0_v)
                 judged.append(j)
                 if not j.refused:

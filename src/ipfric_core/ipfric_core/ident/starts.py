@@ -16,7 +16,7 @@ from .model import FRICTION_FITTED, LAW_PARAMS, Model
 from .problem import Problem
 from .refutations import RIPPLE_PERIODS, response_lag, rest_offset, smallest_moving_command
 
-__all__ = ['DRIVE_GRID', 'effect_starts', 'ripple_starts', 'drive_starts', 'law_starts', 'stribeck_starts',
+__all__ = ['DRIVE_GRID', 'effect_starts', 'ripple_starts', 'phased', 'drive_starts', 'law_starts', 'stribeck_starts',
            'peak_level', 'bristle_starts', 'balance_starts', 'contact_damping']
 
 
@@ -25,8 +25,8 @@ def effect_starts(pr: Problem, model: Model, name: str, prior: Model) -> list[di
     also name other parameters of ``model`` (``prior``: the declared model)."""
     rec = pr.rec
     if name == 'cogging':
-        return ([{'cogging_period_m': p} for p in (0.002, 0.0035, 0.006, 0.01, 0.015, 0.02)]
-                + [phased(pr, model, q) for q in ripple_starts(rec, model)])
+        return [{'cogging_period_m': p} for p in (0.002, 0.0035, 0.006, 0.01, 0.015, 0.02)] + ripple_starts(
+            rec, model, replay=pr)
     if name == 'delay':
         return [{'input_delay_s': d} for d in sorted({0.003, 0.01, 0.02, round(response_lag(rec), 4) or 0.001})]
     if name == 'deadzone':
@@ -54,14 +54,15 @@ RIPPLE_RANGE = (0.0015, 0.03)
 RIPPLE_OVERSAMPLE = 4
 
 
-def ripple_starts(rec: Record, model: Model, keep: int = 2) -> list[dict]:
+def ripple_starts(rec: Record, model: Model, keep: int = 2, replay: Problem | None = None) -> list[dict]:
     """Cogging starts from the cart's force balance (:mod:`~ipfric_core.ident.equation_error`) of
     ``model``: its residual's periodogram over the position (Lomb-Scargle, periods of RIPPLE_RANGE, at
     RIPPLE_OVERSAMPLE frequencies per peak width), the ``keep`` peaks (15 % apart at least) that explain
     most of it, each with its amplitudes from the residual regressed on sin and cos(2 pi x / P) (the
     sign that lowers the balance's residual: the residual is minus the force the model lacks). From
     amplitudes of 0 the period has no gradient, and a fit from the nearest fixed period may stay at a
-    small ripple of the wrong phase. Empty where the balance cannot be formed."""
+    small ripple of the wrong phase. With ``replay``, each start then where the replay of its cart's windows
+    prefers it (:func:`phased`). Empty where the balance cannot be formed."""
     from .equation_error import Prepared, balance, parts
     try:
         pr = Prepared(rec)
@@ -99,39 +100,39 @@ def ripple_starts(rec: Record, model: Model, keep: int = 2) -> list[dict]:
             res = balance(pr, {**p, **q}, active + ('cogging',)).r
             signed.append((float(res @ res), q))
         out.append(min(signed, key=lambda t: t[0])[1])
-    return out
+    return out if replay is None else [phased(replay, model, q, travel) for q in out]
 
 
-#: the phases [rad], periods (steps of a quarter of the periodogram's spacing) and size factors :func:`phased`
-#: tries about a ripple start
+#: the phases [rad] and periods (steps of a quarter of the periodogram's spacing) :func:`phased` tries at
+#: twice the balance's size, then the sizes (factors of the balance's) at the best of them
 PHASE_TURNS = np.arange(8) * (np.pi / 4)
 PERIOD_STEPS = (-2, -1, 0, 1, 2)
-AMPLITUDE_FACTORS = (1.0, 2.0, 4.0)
+AMPLITUDE_FACTORS = (2.0, 1.0, 4.0)
 
 
-def phased(pr: Problem, model: Model, q: dict) -> dict:
-    """The ripple start ``q`` (:func:`ripple_starts`) at the period, phase and size that replay the cart's
-    windows of ``pr`` best, one simulation each: periods within half the periodogram's spacing of its own
-    (PERIOD_STEPS) at each of PHASE_TURNS about its phase, then AMPLITUDE_FACTORS of its size. The force
-    balance finds the period to within a spacing, over a hundred periods of travel a drift of a quarter
-    period, and its filtered derivatives lag the position and smooth the ripple away: on a 3.17 mm
-    cogging of 0.010 N it gave 3.165 mm and 0.0036 N about 50 degrees off, and a fit from there ended in
-    another minimum of the simulation error (2.5 counts; from the truth 1.6)."""
+def phased(pr: Problem, model: Model, q: dict, travel: float) -> dict:
+    """The ripple start ``q`` of :func:`ripple_starts` (over ``travel`` [m]) at the period, phase and size that
+    replay the cart's windows of ``pr`` best, one simulation each (42): the periods within half the
+    periodogram's spacing of its own (PERIOD_STEPS) at each of PHASE_TURNS about its phase, at twice its
+    size, then that one at AMPLITUDE_FACTORS of its size. The force balance finds the period to within a
+    spacing, over a hundred periods of travel a drift of a quarter period, and its filtered derivatives lag
+    the position and smooth the ripple away: on a 3.17 mm cogging of 0.010 N it gave 3.165 mm and 0.0036 N
+    about 50 degrees off, and a fit from there ended in another minimum of the simulation error (2.5
+    counts; from the truth 1.6)."""
     base = model.with_effect('cogging')
     size, phase = math.hypot(q['cogging_sin_N'], q['cogging_cos_N']), math.atan2(q['cogging_cos_N'], q['cogging_sin_N'])
     period = float(q['cogging_period_m'])
-    step = period ** 2 / (4 * RIPPLE_OVERSAMPLE * max(float(np.ptp(pr.rec.x)), period))
+    step = period ** 2 / (4 * RIPPLE_OVERSAMPLE * max(travel, period))
 
-    def start(f: float, d: float, p: float) -> dict:
-        return {'cogging_period_m': p, 'cogging_sin_N': f * size * math.cos(phase + d),
-                'cogging_cos_N': f * size * math.sin(phase + d)}
-
-    def cost(t: dict) -> float:
-        return pr.cart_cost(base.with_values(t))
-    mid = AMPLITUDE_FACTORS[len(AMPLITUDE_FACTORS) // 2]
-    best = min((start(mid, d, period + k * step) for k in PERIOD_STEPS for d in PHASE_TURNS), key=cost)
-    phase = math.atan2(best['cogging_cos_N'], best['cogging_sin_N'])
-    return min((start(f, 0.0, best['cogging_period_m']) for f in AMPLITUDE_FACTORS), key=cost)
+    def scored(f: float, turn: float, p: float) -> tuple[float, dict]:
+        t = {'cogging_period_m': p, 'cogging_sin_N': f * size * math.cos(turn),
+             'cogging_cos_N': f * size * math.sin(turn)}
+        return pr.cart_cost(base.with_values(t)), t
+    first, *others = AMPLITUDE_FACTORS
+    best = min((scored(first, phase + d, period + k * step) for k in PERIOD_STEPS for d in PHASE_TURNS),
+               key=lambda c: c[0])
+    turn = math.atan2(best[1]['cogging_cos_N'], best[1]['cogging_sin_N'])
+    return min([best] + [scored(f, turn, best[1]['cogging_period_m']) for f in others], key=lambda c: c[0])[1]
 
 
 #: the grid :func:`drive_starts` evaluates: plays [m], motor-side masses [share of M], contact
