@@ -223,6 +223,21 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
     return {'steps': steps, 'tried': tried, 'rounds': rounds, 'verdict': v, 'estimation': est, 'validation': val}
 
 
+def take_back(pe: Problem, pv: Problem, declared: Model, current: Model, candidate: Model, label: str, why,
+              steps: list, say) -> Model:
+    """``candidate`` (``current`` with a step taken back) fitted, where it leaves the validation error within
+    WORSE_PERCENT of ``current``'s and neither ends on a bound nor never starts the cart: then a step ``label``
+    with the note ``why(before, after)`` (the validation errors [counts]) is added and the fit returned; else
+    ``current`` (:func:`undo_corrections`, :func:`drop_spent`)."""
+    m, s = fit_model(pe, candidate, prior=declared)
+    before, after = pv.summary(current)['x_rms_counts'], pv.summary(m)['x_rms_counts']
+    if after > before * (1 + WORSE_PERCENT / 100) or on_bounds(m) or never_starts(pe.rec, m):
+        return current
+    steps.append(Step(label, m, s, pe.summary(m), pv.summary(m), [why(before, after)]))
+    say(f'{label}: validation x error {after:.3g} counts (before {before:.3g})')
+    return m
+
+
 def undo_corrections(pe: Problem, pv: Problem, declared: Model, current: Model, steps: list, say) -> Model:
     """The final model with each plant correction that the data no longer support held at its declared
     value again: one that a later round's effect took over (a delay read first as a weaker motor) ends
@@ -234,15 +249,10 @@ def undo_corrections(pe: Problem, pv: Problem, declared: Model, current: Model, 
         s = std.get(name) if isinstance(std, dict) else None
         if not p.free or declared.param(name).free or not near(p.value, declared[name], s):
             continue
-        m, s2 = fit_model(pe, current.holding({name: declared[name]}), prior=declared)
-        before, after = pv.summary(current)['x_rms_counts'], pv.summary(m)['x_rms_counts']
-        if after > before * (1 + WORSE_PERCENT / 100) or on_bounds(m) or never_starts(pe.rec, m):
-            continue
         note = (f'the data no longer move {name} from its declared {declared[name]:.4g} {p.unit} (the correction '
                 f'ended at {p.value:.4g} +/- {s:.2g} {p.unit}): held there again')
-        steps.append(Step(f'{name} as declared', m, s2, pe.summary(m), pv.summary(m), [note]))
-        say(f'{name} as declared: validation x error {after:.3g} counts (with the correction {before:.3g})')
-        current = m
+        current = take_back(pe, pv, declared, current, current.holding({name: declared[name]}), f'{name} as declared',
+                            lambda _before, _after, note=note: note, steps, say)
     return current
 
 
@@ -256,16 +266,11 @@ def drop_spent(pe: Problem, pv: Problem, declared: Model, current: Model, steps:
     for name in [e for e in current.effects if e not in declared.effects]:
         if f'+ {name}' not in kept or kept[-1] == f'+ {name}':
             continue
-        m, s = fit_model(pe, current.without(name), prior=declared)
-        before, after = pv.summary(current)['x_rms_counts'], pv.summary(m)['x_rms_counts']
-        if after > before * (1 + WORSE_PERCENT / 100) or on_bounds(m) or never_starts(pe.rec, m):
-            continue
-        note = (f'{name}, which a later step may have taken over: without it, the rest refitted, the validation '
-                f'error is {after:.3g} counts against {before:.3g} (within {WORSE_PERCENT:g} %): dropped')
-        steps.append(Step(f'- {name}', m, s, pe.summary(m), pv.summary(m), [note]))
-        say(f'- {name}: validation x error {after:.3g} counts (with it {before:.3g})')
-        current = m
-        kept.append(f'- {name}')
+        current = take_back(pe, pv, declared, current, current.without(name), f'- {name}',
+                            lambda before, after, name=name: (
+                                f'{name}, which a later step may have taken over: without it, the rest refitted, '
+                                f'the validation error is {after:.3g} counts against {before:.3g} (within '
+                                f'{WORSE_PERCENT:g} %): dropped'), steps, say)
     return current
 
 
