@@ -17,7 +17,8 @@ from .effects import PARAMS, static_level
 from .model import Model
 from .problem import Problem
 
-__all__ = ['SIZE', 'stops_and_starts', 'smallest_moving_command', 'steady_speeds', 'response_lag', 'drive_crossings',
+__all__ = ['SIZE', 'RIPPLE_PERIODS', 'stops_and_starts', 'smallest_moving_command', 'steady_speeds', 'response_lag',
+           'drive_crossings',
            'contradictions', 'unresolved', 'near', 'uncorrected', 'rest_offset', 'no_static_level', 'bound_params',
            'on_bounds', 'untold', 'reversals', 'never_starts']
 
