@@ -223,17 +223,18 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
     return {'steps': steps, 'tried': tried, 'rounds': rounds, 'verdict': v, 'estimation': est, 'validation': val}
 
 
-def take_back(pe: Problem, pv: Problem, declared: Model, current: Model, candidate: Model, label: str, why,
+def take_back(pe: Problem, pv: Problem, declared: Model, current: Model, candidate: Model, label: str, note: str,
               steps: list, say) -> Model:
     """``candidate`` (``current`` with a step taken back) fitted, where it leaves the validation error within
     WORSE_PERCENT of ``current``'s and neither ends on a bound nor never starts the cart: then a step ``label``
-    with the note ``why(before, after)`` (the validation errors [counts]) is added and the fit returned; else
-    ``current`` (:func:`undo_corrections`, :func:`drop_spent`)."""
+    with ``note`` and the two validation errors [counts] is added and the fit returned; else ``current``
+    (:func:`undo_corrections`, :func:`drop_spent`)."""
     m, s = fit_model(pe, candidate, prior=declared)
     before, after = pv.summary(current)['x_rms_counts'], pv.summary(m)['x_rms_counts']
     if after > before * (1 + WORSE_PERCENT / 100) or on_bounds(m) or never_starts(pe.rec, m):
         return current
-    steps.append(Step(label, m, s, pe.summary(m), pv.summary(m), [why(before, after)]))
+    note += f' (validation error {after:.3g} counts, {before:.3g} before; within {WORSE_PERCENT:g} %)'
+    steps.append(Step(label, m, s, pe.summary(m), pv.summary(m), [note]))
     say(f'{label}: validation x error {after:.3g} counts (before {before:.3g})')
     return m
 
@@ -252,7 +253,7 @@ def undo_corrections(pe: Problem, pv: Problem, declared: Model, current: Model, 
         note = (f'the data no longer move {name} from its declared {declared[name]:.4g} {p.unit} (the correction '
                 f'ended at {p.value:.4g} +/- {s:.2g} {p.unit}): held there again')
         current = take_back(pe, pv, declared, current, current.holding({name: declared[name]}), f'{name} as declared',
-                            lambda _before, _after, note=note: note, steps, say)
+                            note, steps, say)
     return current
 
 
@@ -267,10 +268,8 @@ def drop_spent(pe: Problem, pv: Problem, declared: Model, current: Model, steps:
         if f'+ {name}' not in kept or kept[-1] == f'+ {name}':
             continue
         current = take_back(pe, pv, declared, current, current.without(name), f'- {name}',
-                            lambda before, after, name=name: (
-                                f'{name}, which a later step may have taken over: without it, the rest refitted, '
-                                f'the validation error is {after:.3g} counts against {before:.3g} (within '
-                                f'{WORSE_PERCENT:g} %): dropped'), steps, say)
+                            f'{name}, which a later step may have taken over, dropped and the rest refitted',
+                            steps, say)
     return current
 
 
