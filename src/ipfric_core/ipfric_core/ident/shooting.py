@@ -187,7 +187,7 @@ def drive_states(pp, gap, mass, stiffness, t, u, motion):
     acceleration); at an edge of the play in contact, moving with the cart, until the contact force
     F = alpha u - beta x' - mass x'' turns against that edge. In contact the contact is compressed by
     F / ``stiffness`` [N/m] beyond the edge (a 0.04 mm play against a 22 kN/m contact pushing 1 N is
-    compressed by as much as its play)."""
+    compressed by as much as its play; a contact of no stiffness yet, an effect not fitted, is not)."""
     n = len(t)
     out = np.empty((n, 3))
     half = 0.5 * gap
@@ -195,7 +195,7 @@ def drive_states(pp, gap, mass, stiffness, t, u, motion):
     for k in range(n):
         v0 = motion[k, 0]
         push = motor_force(pp, u[k], v0) - mass * motion[k, 1]
-        squeezed = side * max(side * push, 0.0) / stiffness if side != 0.0 else 0.0
+        squeezed = side * max(side * push, 0.0) / stiffness if side != 0.0 and stiffness > 0.0 else 0.0
         out[k, 0], out[k, 1], out[k, 2] = d + squeezed, vb, side
         if k == n - 1:
             break
