@@ -89,7 +89,7 @@ def drive_crossings(pr: Problem, model: Model) -> np.ndarray:
     (:func:`shooting.drive_states`)."""
     rec, vec = pr.rec, model.vectors()
     drive = vec.truth.drive_vector()
-    side = shooting.drive_states(vec.pp, drive[0], drive[1], drive[2], rec.t, shooting.applied_commands(vec, rec),
+    side = shooting.drive_states(vec.pp, drive, rec.t, shooting.applied_commands(vec, rec),
                                  pr.blocks[0][1].motion)[:, 2]
     touch = np.flatnonzero(side != 0.0)
     if len(touch) < 2:

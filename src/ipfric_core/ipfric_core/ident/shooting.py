@@ -33,7 +33,7 @@ import numpy as np
 
 from ..analysis.records import Record, smooth_rate
 from ..physics.compiled import compiled
-from ..physics.plant import motor_force, motor_side_free
+from ..physics.plant import drive_contact_depth, motor_force, motor_side_free
 from ..physics.rig import drive_means, drive_pieces, input_effects, inputs_through, play
 from ..physics.simulate import advance, advance_drive
 
@@ -178,25 +178,25 @@ def angle_windows(rec: Record) -> Windows:
 
 
 @compiled
-def drive_states(pp, gap, mass, stiffness, t, u, motion):
+def drive_states(pp, dp, t, u, motion):
     """(d, vb, side) of a drive with play at every sample ((d, vb) is the state of
     :func:`~ipfric_core.physics.simulate.advance_drive`; side +1 / -1 in contact pushing forward
     / backward, 0 in the play), estimated by running its motor side along the measured cart: in
     the play as :func:`~ipfric_core.physics.plant.motor_side_free` under the command ``u``
     (after the input effects) while the cart moves as measured (``motion``: speed,
     acceleration); at an edge of the play in contact, moving with the cart, until the contact force
-    F = alpha u - beta x' - mass x'' turns against that edge. In contact the contact is compressed by
-    F / ``stiffness`` [N/m] beyond the edge (a 0.04 mm play against a 22 kN/m contact pushing 1 N is
-    compressed by as much as its play; a contact of no stiffness yet, an effect not fitted, is not)."""
+    F = alpha u - beta x' - mass x'' turns against that edge, the contact compressed by that force
+    (:func:`~ipfric_core.physics.plant.drive_contact_depth`: a 0.04 mm play against a 22 kN/m contact
+    pushing 1 N is compressed by as much as its play). ``dp``: the drive as
+    :func:`~ipfric_core.physics.simulate.advance_drive` takes it (play, motor-side mass, stiffness, damping)."""
     n = len(t)
     out = np.empty((n, 3))
-    half = 0.5 * gap
+    half, mass = 0.5 * dp[0], dp[1]
     d, vb, side = 0.0, motion[0, 0], 0.0
     for k in range(n):
         v0 = motion[k, 0]
         push = motor_force(pp, u[k], v0) - mass * motion[k, 1]
-        squeezed = side * max(side * push, 0.0) / stiffness if side != 0.0 and stiffness > 0.0 else 0.0
-        out[k, 0], out[k, 1], out[k, 2] = d + squeezed, vb, side
+        out[k, 0], out[k, 1], out[k, 2] = drive_contact_depth(dp, side, push) if side != 0.0 else d, vb, side
         if k == n - 1:
             break
         v1 = motion[k + 1, 0]
@@ -389,8 +389,7 @@ def predict(model, rec: Record, win: Windows) -> Prediction:
     rate_step = np.maximum(np.abs(win.state[:, 2]), START_COUNTS * rec.x_resolution / (span * rec.dt))
     out = np.full((len(rec.t), 2), np.nan)
     drive = tuple(float(v) for v in tr.drive_vector())
-    drive0 = (drive_states(model.pp, drive[0], drive[1], drive[2], rec.t, applied_commands(model, rec),
-                           win.motion)[win.start]
+    drive0 = (drive_states(model.pp, drive, rec.t, applied_commands(model, rec), win.motion)[win.start]
               if drive[0] > 0.0 else np.zeros((len(win), 3)))
     _shoot(model.pp, model.fp, tr.force_vector(), tr.deadzone_V, tr.saturation_V, tr.backlash_m, tr.bias_theta_rad,
            drive, drive0, rec.t, first, durations, commands, win.start, win.stop,

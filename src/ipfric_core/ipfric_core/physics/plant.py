@@ -20,6 +20,7 @@ from .params import FrictionParams, PlantParams
 
 __all__ = ['plant_vector', 'motor_force', 'held_force', 'required_forces', 'held_forces', 'pendulum_residuals',
            'stuck_theta_acceleration', 'undeclared_force', 'NO_EXTRA_FORCE', 'motor_side_free', 'drive_contact_force',
+           'drive_contact_depth',
            'undeclared_forces', 'rates', 'CartPendulum', 'cogging_amplitude_phase']
 
 # Positions in the plant vector.
@@ -160,6 +161,16 @@ def drive_contact_force(dp, d: float, dv: float) -> float:
     if d < -half:
         return min(dp[2] * (d + half) + dp[3] * dv, 0.0)
     return 0.0
+
+
+@compiled
+def drive_contact_depth(dp, side: float, force: float) -> float:
+    """Motor side minus cart [m] at which a drive's contact on ``side`` (+1 forward, -1 backward), at rest
+    relative to the cart, carries ``force`` [N]: :func:`drive_contact_force` inverted (dv = 0), the edge of
+    the play plus the compression |F| / k beyond it (the edge itself for a pull, or a contact of no
+    stiffness yet: an effect not fitted)."""
+    squeeze = max(side * force, 0.0) / dp[2] if dp[2] > 0.0 else 0.0
+    return side * (0.5 * dp[0] + squeeze)
 
 
 @compiled
