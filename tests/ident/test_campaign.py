@@ -231,14 +231,28 @@ def test_the_generator_parts_a_drive_into_its_play_and_its_mass(seed, index, pla
 
 def test_the_true_drive_replays_the_generators_drive(tmp_path):
     """Seed 2027, case 74, 30 s: a cart at 1 kHz with overruns, a 0.04 mm play (2.3 counts) against a 22 kN/m
-    contact. The identification's drive with the generator's true values replays the record to 2.95 counts
-    RMS on validation; with the contact at the edge of the play in each window's start, not compressed by
-    the force it carries (as much as the play itself at 1 N), it left 37.8."""
+    contact. The identification's drive with the generator's true values replays the record to 2.13 counts
+    RMS on validation (2.95 with the motor side's start state estimated along the measured cart rather than
+    from the model's lead); with the contact at the edge of the play in each window's start, not compressed
+    by the force it carries (as much as the play itself at 1 N), it left 37.8."""
     campaign.generate(tmp_path, 0, 2027, indices=[74], duration=30.0)
     d = tmp_path / campaign.case_name(74)
     truth = json.loads((d / 'truth.json').read_text())
     assert truth['effects']['drive_backlash']['gap_m'] < 2.5 * truth['encoder']['x_count_m']
     assert scorer.oracle(d, truth)['x_rms_counts'] < 5.0
+
+
+def test_the_true_drive_replays_a_balancing_loop(tmp_path):
+    """Seed 2027, case 170, 30 s: an LQR balancing loop at 1 kHz on a drive with a 0.24 mm play. The motor
+    side's state and the cart's rate at each window's start, taken from the model's own lead over the second
+    before, let the true drive replay the record to 0.65 counts RMS on validation; estimated along the measured
+    cart (the open-loop :func:`~ipfric_core.ident.shooting.drive_states`) they left 26.4, and a heavier cart
+    without play explained the record as well as the true drive."""
+    campaign.generate(tmp_path, 0, 2027, indices=[170], duration=30.0)
+    d = tmp_path / campaign.case_name(170)
+    truth = json.loads((d / 'truth.json').read_text())
+    assert truth['experiment'] == 'loop' and truth['effects']['drive_backlash']['gap_m'] > 1e-4
+    assert scorer.oracle(d, truth)['x_rms_counts'] < 2.0
 
 # ------------------------------------------------------------------------------------------ slow
 @pytest.fixture(scope='module')

@@ -9,7 +9,10 @@ rate within M / (beta + eps); a local fit gives a cart that stops and starts wit
 balancing loop chattering at its sample rate, the mean rate of that span, and the model would carry
 that error through the window: 23 counts RMS where the true model with the rate from a lead leaves
 0.5), then refined to the one (or the rest) that best replays the window's first ``START_FIT_S`` of
-readings. The cart is judged on windows of ``CART_WINDOW_S``; with a
+readings. With a drive play the motor side's state, which no sensor reads, and the cart's rate are the
+model's own over the ``DRIVE_LEAD_S`` before the start (true drives of the randomised campaign: 0.5-36
+counts left from the state estimated along the measured cart, 0.4-9 from that lead, against floors of
+0.3-8). The cart is judged on windows of ``CART_WINDOW_S``; with a
 pendulum attached its angle is taken from the measurement there (the upright pendulum is
 unstable: a small error in its initial rate would grow into the cart's motion), and the
 angle itself is judged on short windows of ``PENDULUM_WINDOW_S`` of the free coupled motion. The model (the
@@ -55,6 +58,10 @@ START_COUNTS = 10.0
 LEAD_S = 0.1         # no window starts earlier: a delayed command there would come from before the record [s]
 #: a window that starts in motion starts at the rate the model reaches over this long before it [s]
 LEAD_RATE_S = 0.15
+#: a window of a model with a drive play starts at the motor side's state and the cart's rate the model
+#: reaches over this long before it: a few of the coupled drive's (M + motor-side mass) / (beta + eps),
+#: 0.13-0.65 s on the campaign's rigs [s]
+DRIVE_LEAD_S = 1.0
 
 
 @dataclass(frozen=True)
@@ -281,14 +288,16 @@ def _start_rate(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, first,
 
 
 @compiled
-def _lead_rate(pp, fp, ef, deadzone, saturation, drive, first, durations, commands, a, k0, s, dr, substep, forced,
-               theta_bias, pendulum, xm, speed):
-    """The start state ``s`` at sample k0 with the cart's rate that the model reaches from sample
-    ``a`` under the recorded commands, started there at the measured position and smoothed rate ``speed[a]``
-    (the angle forced as in :func:`_sample`): the cart forgets its start rate within M / (beta + eps), so a
-    lead of a few of those gives the rate from the commands rather than from differences of quantized
-    readings (a balancing loop at 2.1 ms whose cart reverses within the local fit's span: rates 0.074 m/s
-    off, RMS, from the fit, 0.002 m/s from a 60 ms lead)."""
+def _lead(pp, fp, ef, deadzone, saturation, drive, first, durations, commands, a, k0, s, dr, substep, forced,
+          theta_bias, pendulum, xm, speed):
+    """The model's cart rate and drive state at sample k0, reached from sample ``a`` under the recorded
+    commands, started there at the measured position and smoothed rate ``speed[a]`` with the drive state
+    ``dr`` (the angle forced as in :func:`_sample`); returns the start state ``s`` with that rate, and the
+    drive state. The cart forgets its start rate within M / (beta + eps), so a lead of a few of those gives
+    the rate from the commands rather than from differences of quantized readings (a balancing loop at
+    2.1 ms whose cart reverses within the local fit's span: rates 0.074 m/s off, RMS, from the fit, 0.002
+    m/s from a 60 ms lead); a drive's motor side, which no sensor reads, forgets its state as the coupled
+    drive does, within (M + motor-side mass) / (beta + eps)."""
     ls = (xm[a], forced[a, 0] - theta_bias if len(forced) > 0 else s[1], speed[a],
           forced[a, 1] if len(forced) > 0 else s[3], s[4])
     mode = (0.0, 0.0, 0.0)
@@ -296,13 +305,13 @@ def _lead_rate(pp, fp, ef, deadzone, saturation, drive, first, durations, comman
         ls, mode, dr = _sample(pp, fp, ef, deadzone, saturation, drive, first, durations, commands, k, ls, mode, dr,
                                substep, forced, theta_bias, pendulum)
         if not math.isfinite(ls[2]):
-            return s
-    return (s[0], s[1], ls[2], s[3], s[4])
+            return s, (math.nan, math.nan)
+    return (s[0], s[1], ls[2], s[3], s[4]), dr
 
 
 @compiled(parallel=True)   # the windows are independent: one thread each
-def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, drive0, t, first, durations, commands,
-           start, stop, state, held, substep, forced, angle, xm, fit_n, rate_step, lead_n, speed, out):
+def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, drives, t, first, durations, commands,
+           start, stop, state, held, substep, forced, angle, xm, fit_n, rate_step, lead_n, drive_lead_n, speed, out):
     """Encoder readings (x, theta) predicted in every window, written into ``out`` (n, 2). Each
     sample interval k is integrated over its pieces of constant applied command (``first``,
     ``durations``, ``commands`` of :func:`~ipfric_core.physics.rig.drive_pieces`), each through
@@ -312,21 +321,31 @@ def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, drive0, t, 
     window is NaN). A window that starts in motion starts at the cart rate (or at rest) that best replays
     its first ``fit_n`` readings ``xm`` (:func:`_start_rate`, ``rate_step`` [m/s] its scale), searched
     around the rate the model reaches over the ``lead_n`` samples before from the smoothed rate ``speed``
-    there (:func:`_lead_rate`), unless the
-    model has a drive play (``drive`` as :func:`~ipfric_core.physics.simulate.advance_drive` takes it,
-    play > 0): then each window starts from the drive state ``drive0`` (n_windows, 2+) of
-    :func:`drive_states`, the cart's rate with it."""
+    there (:func:`_lead`), unless the model has a drive play (``drive`` as
+    :func:`~ipfric_core.physics.simulate.advance_drive` takes it, play > 0): then the window's drive state
+    and, in motion, the cart's rate are the model's own over the ``drive_lead_n`` samples before, from the
+    drive state ``drives`` (n, 3) of :func:`drive_states` there (a window whose angle is free, or that has
+    no such lead, starts from ``drives`` at its start)."""
     pendulum = pp[1] > 0.0
     for w in numba.prange(len(start)):
         s = (state[w, 0], state[w, 1] - theta_bias, state[w, 2], state[w, 3], state[w, 4])
         mode = (held[w], 0.0, 0.0)
-        dr = (drive0[w, 0], drive0[w, 1])
-        reading = s[0]
         k0 = start[w]
-        if held[w] == 0.0 and fit_n > 0 and drive[0] == 0.0:
+        dr = (drives[k0, 0], drives[k0, 1])
+        reading = s[0]
+        if drive[0] > 0.0:
+            a = k0 - drive_lead_n
+            if a >= 0 and (len(forced) > 0 or not pendulum):
+                ls, ldr = _lead(pp, fp, ef, deadzone, saturation, drive, first, durations, commands, a, k0, s,
+                                (drives[a, 0], drives[a, 1]), substep, forced, theta_bias, pendulum, xm, speed)
+                if math.isfinite(ldr[0]):
+                    dr = ldr
+                    if held[w] == 0.0:
+                        s = ls
+        elif held[w] == 0.0 and fit_n > 0:
             if lead_n > 0:
-                s = _lead_rate(pp, fp, ef, deadzone, saturation, drive, first, durations, commands,
-                               max(0, k0 - lead_n), k0, s, dr, substep, forced, theta_bias, pendulum, xm, speed)
+                s = _lead(pp, fp, ef, deadzone, saturation, drive, first, durations, commands,
+                          max(0, k0 - lead_n), k0, s, dr, substep, forced, theta_bias, pendulum, xm, speed)[0]
             k1 = min(k0 + fit_n, stop[w] - 1)
             v, mode = _start_rate(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, first, durations,
                                   commands, k0, k1, s, mode, dr, substep, forced, pendulum, xm, rate_step[w])
@@ -389,13 +408,14 @@ def predict(model, rec: Record, win: Windows) -> Prediction:
     rate_step = np.maximum(np.abs(win.state[:, 2]), START_COUNTS * rec.x_resolution / (span * rec.dt))
     out = np.full((len(rec.t), 2), np.nan)
     drive = tuple(float(v) for v in tr.drive_vector())
-    drive0 = (drive_states(model.pp, drive, rec.t, applied_commands(model, rec), win.motion)[win.start]
-              if drive[0] > 0.0 else np.zeros((len(win), 3)))
+    drives = (drive_states(model.pp, drive, rec.t, applied_commands(model, rec), win.motion)
+              if drive[0] > 0.0 else np.zeros((len(rec.t), 3)))
     _shoot(model.pp, model.fp, tr.force_vector(), tr.deadzone_V, tr.saturation_V, tr.backlash_m, tr.bias_theta_rad,
-           drive, drive0, rec.t, first, durations, commands, win.start, win.stop,
+           drive, drives, rec.t, first, durations, commands, win.start, win.stop,
            win.state, win.held, min(1e-3, rec.dt), win.forced,
            rec.theta if rec.theta is not None else np.zeros(len(rec.t)), rec.x, fit_n, rate_step,
-           int(round(LEAD_RATE_S / rec.dt)), np.ascontiguousarray(win.motion[:, 0]), out)
+           int(round(LEAD_RATE_S / rec.dt)), int(round(DRIVE_LEAD_S / rec.dt)),
+           np.ascontiguousarray(win.motion[:, 0]), out)
     window_of = np.full(len(rec.t), -1)
     for i, (a, b) in enumerate(zip(win.start, win.stop)):
         window_of[a + 1:b] = i
