@@ -189,7 +189,11 @@ def short_fits(pe: Problem, current: Model, hs: list[Hypothesis], prior: Model, 
     left it, and fits the law with its own parameters in full. From the declared friction, a short fit of
     the levels alone could not reach what the refit reaches by the viscous slope and the Stribeck
     velocity too, and every such effect lost to the refit, or to a plant correction that took the refit
-    with it (a delay of a sixth of a sample answered by alpha 0.8 % low). A plant correction, which
+    with it (a delay of a sixth of a sample answered by alpha 0.8 % low). Such an effect also starts
+    from its own short fit on the declared friction, the whole law free from there: a refit without the
+    effect may have bent the law to make up for it (an amplifier clipping at 4.5 V: the refit sank the
+    viscous slope to its bound 0, and the clipping fitted from there stayed on it, while from the clipping
+    fitted on the declared friction the law reached the truth and 0.45 counts). A plant correction, which
     refits the whole law itself, starts from both: a refit without it may have bent the friction to
     make up for a wrong mass (a motor side that moves with the cart: the viscous slope sank to 0)."""
     out: dict[int, tuple[Model, float]] = {i: short_fit(pe, current, h, prior, ps)
@@ -199,13 +203,22 @@ def short_fits(pe: Problem, current: Model, hs: list[Hypothesis], prior: Model, 
         refit = next(iter(out.values()))[0]
         law = LAW_PARAMS[refit.law]
         seed = {n: refit[n] for n in law}
+    with_levels = [i for i, h in enumerate(hs) if h.kind == 'effect' and set(h.free) - set(h.own)]
     for i, h in enumerate(hs):
-        if i in out:
+        if i in out or i in with_levels:
             continue
-        if seed and h.kind == 'effect' and set(h.free) - set(h.own):
-            h = replace(h, model=h.model.with_free(law), starts=[{**seed, **st} for st in h.starts])
-        elif seed and h.kind == 'plant':
+        if seed and h.kind == 'plant':
             h = replace(h, starts=h.starts + [seed])
+        hs[i] = h
+        out[i] = short_fit(pe, current, h, prior, ps)
+    on_declared = {h.effect: out[i][0] for i, h in enumerate(hs)
+                   if h.kind == 'effect' and i not in with_levels}
+    for i in with_levels:
+        h = hs[i]
+        if seed:
+            own = on_declared.get(h.effect)
+            h = replace(h, model=h.model.with_free(law), starts=[{**seed, **st} for st in h.starts]
+                        + ([{n: own[n] for n in h.own}] if own is not None else []))
         hs[i] = h
         out[i] = short_fit(pe, current, h, prior, ps)
     return [out[i] for i in range(len(hs))]
