@@ -192,10 +192,11 @@ def short_fits(pe: Problem, current: Model, hs: list[Hypothesis], prior: Model, 
     with it (a delay of a sixth of a sample answered by alpha 0.8 % low). Such an effect also starts
     from its own short fit on the declared friction, the whole law free from there: a refit without the
     effect may have bent the law to make up for it (an amplifier clipping at 4.5 V: the refit sank the
-    viscous slope to its bound 0, and the clipping fitted from there stayed on it, while from the clipping
-    fitted on the declared friction the law reached the truth and 0.45 counts). A plant correction, which
-    refits the whole law itself, starts from both: a refit without it may have bent the friction to
-    make up for a wrong mass (a motor side that moves with the cart: the viscous slope sank to 0)."""
+    Coulomb level to 0, the clipping fitted from there ended with the viscous slope on its bound 0, while
+    from the clipping fitted on the declared friction the law reached the truth and 0.45 counts). A plant
+    correction, which refits the whole law itself, starts from both: a refit without it may have bent the
+    friction to make up for a wrong mass (a motor side that moves with the cart: the viscous slope sank to
+    0)."""
     out: dict[int, tuple[Model, float]] = {i: short_fit(pe, current, h, prior, ps)
                                            for i, h in enumerate(hs) if h.kind == 'friction'}
     seed = {}

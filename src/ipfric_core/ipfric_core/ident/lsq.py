@@ -153,6 +153,8 @@ def quadratic(objective, x, lo, hi, se, level, at: float, cols):
                 if objective(xi) - at < QUADRATIC_RISE * (d / se[i]) ** 2 * level[i]:
                     out.append(i)
                     break
+                if d < k * se[i]:           # the bound stopped this probe: none farther on this side
+                    break
             if out and out[-1] == i:
                 break
     return out

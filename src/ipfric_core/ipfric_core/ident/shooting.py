@@ -10,9 +10,9 @@ balancing loop chattering at its sample rate, the mean rate of that span, and th
 that error through the window: 23 counts RMS where the true model with the rate from a lead leaves
 0.5), then refined to the one (or the rest) that best replays the window's first ``START_FIT_S`` of
 readings. With a drive play the motor side's state, which no sensor reads, and the cart's rate are the
-model's own over the ``DRIVE_LEAD_S`` before the start (true drives of the randomised campaign: 0.5-36
-counts left from the state estimated along the measured cart, 0.4-9 from that lead, against floors of
-0.3-8). The cart is judged on windows of ``CART_WINDOW_S``; with a
+model's own over the ``DRIVE_LEAD_S`` before the start (the true drives of 24 cases of the randomised
+campaign: 0.5-134 counts left from the state estimated along the measured cart, 0.4-10 from that lead,
+against floors of 0.3-8.6). The cart is judged on windows of ``CART_WINDOW_S``; with a
 pendulum attached its angle is taken from the measurement there (the upright pendulum is
 unstable: a small error in its initial rate would grow into the cart's motion), and the
 angle itself is judged on short windows of ``PENDULUM_WINDOW_S`` of the free coupled motion. The model (the
@@ -59,8 +59,8 @@ LEAD_S = 0.1         # no window starts earlier: a delayed command there would c
 #: a window that starts in motion starts at the rate the model reaches over this long before it [s]
 LEAD_RATE_S = 0.15
 #: a window of a model with a drive play starts at the motor side's state and the cart's rate the model
-#: reaches over this long before it: a few of the coupled drive's (M + motor-side mass) / (beta + eps),
-#: 0.13-0.65 s on the campaign's rigs [s]
+#: reaches over this long before it: 1.5-8 of the coupled drive's (M + motor-side mass) / (beta + eps),
+#: 0.13-0.65 s on the campaign's rigs (a 0.45 s lead left up to 7.6 counts where 1 s left 1.8) [s]
 DRIVE_LEAD_S = 1.0
 
 
@@ -297,7 +297,8 @@ def _lead(pp, fp, ef, deadzone, saturation, drive, first, durations, commands, a
     the rate from the commands rather than from differences of quantized readings (a balancing loop at
     2.1 ms whose cart reverses within the local fit's span: rates 0.074 m/s off, RMS, from the fit, 0.002
     m/s from a 60 ms lead); a drive's motor side, which no sensor reads, forgets its state as the coupled
-    drive does, within (M + motor-side mass) / (beta + eps)."""
+    drive does, within (M + motor-side mass) / (beta + eps). A lead that diverges returns ``s`` and a drive
+    state of NaN."""
     ls = (xm[a], forced[a, 0] - theta_bias if len(forced) > 0 else s[1], speed[a],
           forced[a, 1] if len(forced) > 0 else s[3], s[4])
     mode = (0.0, 0.0, 0.0)
@@ -324,8 +325,9 @@ def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, drives, t, 
     there (:func:`_lead`), unless the model has a drive play (``drive`` as
     :func:`~ipfric_core.physics.simulate.advance_drive` takes it, play > 0): then the window's drive state
     and, in motion, the cart's rate are the model's own over the ``drive_lead_n`` samples before, from the
-    drive state ``drives`` (n, 3) of :func:`drive_states` there (a window whose angle is free, or that has
-    no such lead, starts from ``drives`` at its start)."""
+    drive state ``drives`` (n, 3) of :func:`drive_states` there (a window whose angle is free, that has no
+    room for such a lead, or whose lead diverged, starts from ``drives`` at its start and the local fit's
+    rate)."""
     pendulum = pp[1] > 0.0
     for w in numba.prange(len(start)):
         s = (state[w, 0], state[w, 1] - theta_bias, state[w, 2], state[w, 3], state[w, 4])
