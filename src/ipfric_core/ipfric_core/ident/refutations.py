@@ -24,6 +24,7 @@ __all__ = ['SIZE', 'RIPPLE_PERIODS', 'stops_and_starts', 'smallest_moving_comman
 
 UNDO_SIGMA = 2.0         # a correction that ends this many standard errors from the declared value or closer is undone
 STOP_S = 0.05            # a stretch this long with the encoder still is a stop [s]
+BREAKAWAY_S = 0.5        # a cart that starts from rest travels three counts within this long [s]
 #: a cogging repeats at least this often over the travel: once repeated, a force is a ripple (a balancing loop's
 #: cart travels 31 mm: a 14 mm cogging of 2.5 counts, fitted at 13.6 mm, was refused at three)
 RIPPLE_PERIODS = 2.0
@@ -252,33 +253,48 @@ def reversals(rec: Record, counts: int = 3) -> int:
 def never_starts(rec: Record, model: Model) -> list[str]:
     """Why ``model``'s cart could not start where the record's did: its static friction (eq. 5 with the
     direction dependence, :func:`~ipfric_core.physics.friction.holding_margin`) holds the cart both ways
-    against the largest force the drive gives at rest, alpha times the largest command through the
-    model's deadzone and saturation, with the track's forces (offset, cogging amplitude) added at their
-    largest, while the record shows the cart
-    starting from rest (:func:`stops_and_starts`, then travelling three counts) or reversing its travel
-    (:func:`reversals`: through zero speed, where static friction holds too). A model that can never move
-    the cart once it stops is not the rig's, whatever its error on windows that start moving. Only for
-    the laws that stick (coulomb, exponential: the dynamic law's bristles creep below the static level),
-    without a drive play (its contact's impacts push harder than the drive's force), on the cart alone (a
-    pendulum's swing pushes the cart too)."""
+    against the force the drive gives at rest, alpha times the command through the model's deadzone and
+    saturation, with the track's forces (offset, cogging amplitude) added at their largest, while the
+    record shows the cart starting from rest (:func:`stops_and_starts`, then travelling three counts within
+    BREAKAWAY_S) or reversing its travel (:func:`reversals`: through zero speed, where static friction holds
+    too). The command is the record's largest, and for the start from rest it did least to cause, the largest
+    within BREAKAWAY_S of that start (a PID cart's log kept a static level of 24.5 N, below the 28 N of its largest
+    command, where it had travelled 16 counts from rest under 0.63 V, 1.5 N). A model that cannot move the
+    cart where it moved is not the rig's, whatever its error on windows that start moving. Only for the laws
+    that stick (coulomb, exponential: the dynamic law's bristles creep below the static level), without a
+    drive play (its contact's impacts push harder than the drive's force), on the cart alone (a pendulum's
+    swing pushes the cart too)."""
     vec = model.vectors()
     if rec.theta is not None or not sticks(vec.fp) or 'drive_backlash' in model.effects:
         return []
     tr = vec.truth
-    volts = input_effects(float(np.max(np.abs(rec.u))), tr.deadzone_V, tr.saturation_V)
     track = abs(model.get('offset_N')) + math.hypot(model.get('cogging_sin_N'), model.get('cogging_cos_N'))
-    push = model['alpha'] * volts + track
-    if holding_margin(vec.fp, push) >= 0.0 or holding_margin(vec.fp, -push) >= 0.0:    # eq. 5: it breaks away
-        return []
+
+    def push(volts: float) -> float:
+        """The largest force [N] the drive and the track give at rest under commands up to ``volts``."""
+        return model['alpha'] * input_effects(volts, tr.deadzone_V, tr.saturation_V) + track
+
+    def holds(force: float) -> bool:
+        return holding_margin(vec.fp, force) < 0.0 and holding_margin(vec.fp, -force) < 0.0
     travel = 2.5 * rec.x_resolution                        # three counts from the still reading
-    starts = sum(1 for still, _ in stops_and_starts(rec)
-                 if np.max(np.abs(rec.x[still:np.searchsorted(rec.t, rec.t[still] + 0.5)] - rec.x[still])) >= travel)
-    turns = reversals(rec)
-    if not starts + turns:
-        return []
-    seen = ' and '.join(w for w in (f'started from rest {starts} times' if starts else '',
-                                    f'reversed its travel {turns} times' if turns else '') if w)
-    return [f'static friction (up to {static_limit(vec.fp):.4g} N) holds the cart against every command of the '
-            f'record (at rest the drive '
-            f'gives at most {push:.4g} N: alpha {model["alpha"]:.4g} N/V times {volts:.4g} V'
-            + (f', the track {track:.3g} N' if track > 0.0 else '') + f'), yet the cart {seen}']
+    starts = [still for still, _ in stops_and_starts(rec)
+              if np.max(np.abs(rec.x[still:np.searchsorted(rec.t, rec.t[still] + BREAKAWAY_S)] - rec.x[still]))
+              >= travel]
+    most = float(np.max(np.abs(rec.u)))
+    if holds(push(most)):
+        turns = reversals(rec)
+        if starts or turns:
+            seen = ' and '.join(w for w in (f'started from rest {len(starts)} times' if starts else '',
+                                            f'reversed its travel {turns} times' if turns else '') if w)
+            return [f'static friction (up to {static_limit(vec.fp):.4g} N) holds the cart against every command '
+                    f'of the record (at rest the drive gives at most {push(most):.4g} N: alpha '
+                    f'{model["alpha"]:.4g} N/V times {input_effects(most, tr.deadzone_V, tr.saturation_V):.4g} V'
+                    + (f', the track {track:.3g} N' if track > 0.0 else '') + f'), yet the cart {seen}']
+    if starts:      # the weakest start: the smallest largest command within BREAKAWAY_S of it
+        volts, still = min((float(np.max(np.abs(rec.u[np.abs(rec.t - rec.t[k]) <= BREAKAWAY_S]))), k)
+                           for k in starts)
+        if holds(push(volts)):
+            return [f'static friction (up to {static_limit(vec.fp):.4g} N) holds the cart against the drive at '
+                    f't = {rec.t[still]:.4g} s (at most {push(volts):.4g} N within {BREAKAWAY_S:g} s: commands up '
+                    f'to {volts:.4g} V), yet the cart started from rest there and travelled three counts']
+    return []
