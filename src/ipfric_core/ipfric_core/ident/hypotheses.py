@@ -159,7 +159,9 @@ def short_fit(pe: Problem, current: Model, h: Hypothesis, prior: Model, ps: Prob
     carry over to every window (it gains REDO_GAIN on the subset, less than SCREEN_GAIN on all, or it
     leaves all REDO_LOSS worse than ``current``: its friction levels wandered off on the subset), the
     fits are done again on ``pe``; on the subset, the gain is counted from the friction levels refitted
-    there alone (:meth:`Problem.baseline`), not from ``current``."""
+    there alone (:meth:`Problem.baseline`), not from ``current``. The best start the data do not contradict
+    (:func:`contradictions`) is taken over a better one they do: a real cart's cogging fitted at 20 mm from
+    one start, fewer than two periods over its 30.6 mm of travel, at a shorter period from another."""
     starts = [h.model.with_values(s) for s in h.starts]
     if h.effect in GRID_SCREENED and h.screened:
         costs = [ps.cart_cost(m) for m in starts]
@@ -172,7 +174,8 @@ def short_fit(pe: Problem, current: Model, h: Hypothesis, prior: Model, ps: Prob
         pr = pr if on_angle else pr.cart()
         fits = [fit_model(pr, m, max_nfev=SCREEN_NFEV, only=set(h.free), prior=prior, errors=False)[0]
                 for m in starts]
-        best = fits[int(np.argmin([pr.cost(m) for m in fits]))]
+        ranked = [fits[i] for i in np.argsort([pr.cost(m) for m in fits])]
+        best = next((m for m in ranked if not (h.effect and contradictions(pe, m, h.effect))), ranked[0])
         return best, 1.0 - pr.cost(best) / pr.cost(pr.baseline(current, levels, prior))
     best, gain = fit(ps)
     full = 1.0 - pe.cost(best) / pe.cost(current)
