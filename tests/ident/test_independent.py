@@ -135,6 +135,27 @@ def test_a_cart_without_coulomb_friction_is_answered_by_the_viscous_law(tmp_path
     assert res['verdict']['explained'], res['verdict']
 
 
+@pytest.mark.long       # two minutes: the friction laws' ladder with the mass free
+def test_a_refit_with_a_free_constant_on_a_bound_is_refused(tmp_path):
+    """The air-bearing cart of the test above with --free M: the first refit (the declared Stribeck curve
+    and M) loses its Coulomb level to its bound; it is refused with that reason, not taken as a step, and
+    the rounds go on from the declared values: the viscous law is kept with M fitted beside it, M and the
+    slope within 3 %, nothing on a bound."""
+    spec = dict(rigsim._case('quanser', 'cart', seed=52), rig_overrides={'mu_s': 0.0, 'mu_c': 0.0})
+    rec = load(rigsim.write_case('air', tmp_path, data=rigsim.simulate(spec, duration=45.0)), None)
+    est, val = rec.split(0.6)
+    declared = load_declared(None, 'exponential', False).freeing(['M'])
+    res = run_ladder(est, val, declared)
+    first = res['steps'][0].notes
+    assert [s.label for s in res['steps']][:2] != ['declared', 'refit'], [s.label for s in res['steps']]
+    assert len(first) == 1 and 'refit of the exponential law with M (--free) is refuted: Fc = ' in first[0], first
+    final = res['steps'][-1].model
+    assert final.law == 'viscous' and final.effects == (), res['tried']
+    assert final['M'] == pytest.approx(rigsim.RIGS['quanser']['M'], rel=0.03)
+    assert final['eps'] == pytest.approx(3.0, rel=0.03)
+    assert not [p.name for p in final.params if p.at_bound(1e-3 * PARAMS[p.name].typical)]
+
+
 def test_a_refit_on_a_bound_has_the_leaner_laws_fitted_in_full(data):
     """The screen of a round (``hypotheses.screen``) on the independent clean cart record: where the refit's
     short fit ends with its Coulomb level on the bound 0, the viscous and Coulomb laws are fitted in full
@@ -146,7 +167,7 @@ def test_a_refit_on_a_bound_has_the_leaner_laws_fitted_in_full(data):
     est, _ = rec.split(0.6)
     pe = Problem(est)
     declared = load_declared(None, 'exponential', False)
-    hs = [h for h in hypotheses(pe, declared, declared) if h.kind != 'effect' or not set(h.free) - set(h.own)]
+    hs = [h for h in hypotheses(pe, declared, declared) if h.kind != 'effect' or not h.levels]
     gains = {'friction': 0.5, 'law': 0.4, 'plant': 0.6, 'effect': 0.7}     # every effect on the declared friction
     for fc, forced in ((0.0, True), (0.3, False)):
         refit = declared.with_free(('Fc', 'Fs_excess', 'eps', 'v_s')).with_values({'Fc': fc})

@@ -79,6 +79,11 @@ class Hypothesis:
     #: starts already explain what the current model does: a drive in place of a mass correction)
     screened: bool = True
 
+    @property
+    def levels(self) -> set:
+        """The parameters its fit moves beside its own: the friction levels refitted with it."""
+        return set(self.free) - set(self.own)
+
 
 def refit_of(current: Model, starts: list | None = None) -> Hypothesis:
     """The hypothesis that ``current``'s friction levels (its law's) are off: they are refitted."""
@@ -167,7 +172,7 @@ def short_fit(pe: Problem, current: Model, h: Hypothesis, prior: Model, ps: Prob
         costs = [ps.cart_cost(m) for m in starts]
         if min(costs) > (1 - SCREEN_GAIN) * ps.cart_cost(current):
             return starts[int(np.argmin(costs))], 0.0   # the best of a grid explains nothing: not fitted
-    levels = set(h.free) - set(h.own)
+    levels = h.levels
     on_angle = h.effect is not None and EFFECTS[h.effect].needs_theta
 
     def fit(pr):
@@ -207,7 +212,7 @@ def short_fits(pe: Problem, current: Model, hs: list[Hypothesis], prior: Model, 
         refit = next(iter(out.values()))[0]
         law = LAW_PARAMS[refit.law]
         seed = {n: refit[n] for n in law}
-    with_levels = [i for i, h in enumerate(hs) if h.kind == 'effect' and set(h.free) - set(h.own)]
+    with_levels = [i for i, h in enumerate(hs) if h.kind == 'effect' and h.levels]
     for i, h in enumerate(hs):
         if i in out or i in with_levels:
             continue
@@ -305,7 +310,7 @@ def screen(hs: list[Hypothesis], short: list[tuple[Model, float]], pe: Problem, 
     refuted = []
     forced = []
     for h, (m, g) in zip(hs, short):
-        levels = bool(set(h.free) - set(h.own)) and h.kind == 'effect'
+        levels = bool(h.levels) and h.kind == 'effect'
         gains.append((levels, 1.0 - pe.cost(m) / base if levels and base else g))
         why = contradictions(pe, m, h.effect) if h.effect and g >= SCREEN_GAIN else []
         refuted.append('its short fit: ' + '; '.join(why) if why else None)

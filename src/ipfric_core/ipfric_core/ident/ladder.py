@@ -141,11 +141,20 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
     say(f'declared model: validation x error {steps[0].val["x_rms_counts"]:.3g} counts')
     if declared.free:        # constants the user asked to fit (--free): fitted with the law first, whatever the verdict
         law = LAW_PARAMS[declared.law]
-        current, s = fit_model(pe, declared.with_free(law), prior=declared)
-        steps.append(Step('refit', current, s, pe.summary(current), pv.summary(current),
-                          correction_notes(declared, current, s, est.theta is None) + refit_notes(declared, current)))
-        say(f'refit with {", ".join(p.name for p in declared.free)}: validation x error '
-            f'{steps[-1].val["x_rms_counts"]:.3g} counts')
+        fitted, s = fit_model(pe, declared.with_free(law), prior=declared)
+        names = ', '.join(p.name for p in declared.free)
+        refuted = on_bounds(fitted) + never_starts(pe.rec, fitted)
+        if refuted:
+            steps[0].notes.append(f'the refit of the {declared.law} law with {names} (--free) is refuted: '
+                                  + '; '.join(refuted) + '; the rounds start from the declared values, '
+                                  f'{names} fitted in each hypothesis')
+            say(f'refit with {names}: refuted ({refuted[0]})')
+        else:
+            current = fitted
+            steps.append(Step('refit', current, s, pe.summary(current), pv.summary(current),
+                              correction_notes(declared, current, s, est.theta is None)
+                              + refit_notes(declared, current)))
+            say(f'refit with {names}: validation x error {steps[-1].val["x_rms_counts"]:.3g} counts')
     tried: list[dict] = []
     rounds: list[dict] = []
     ps = pe.screen()

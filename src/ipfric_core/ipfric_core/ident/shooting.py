@@ -298,14 +298,14 @@ def _lead(pp, fp, ef, deadzone, saturation, drive, first, durations, commands, a
     2.1 ms whose cart reverses within the local fit's span: rates 0.074 m/s off, RMS, from the fit, 0.002
     m/s from a 60 ms lead); a drive's motor side, which no sensor reads, forgets its state as the coupled
     drive does, within (M + motor-side mass) / (beta + eps). A lead that diverges returns ``s`` and a drive
-    state of NaN."""
+    state of NaN (a cart rate or a motor-side rate that is not finite)."""
     ls = (xm[a], forced[a, 0] - theta_bias if len(forced) > 0 else s[1], speed[a],
           forced[a, 1] if len(forced) > 0 else s[3], s[4])
     mode = (0.0, 0.0, 0.0)
     for k in range(a, k0):
         ls, mode, dr = _sample(pp, fp, ef, deadzone, saturation, drive, first, durations, commands, k, ls, mode, dr,
                                substep, forced, theta_bias, pendulum)
-        if not math.isfinite(ls[2]):
+        if not (math.isfinite(ls[2]) and math.isfinite(dr[1])):
             return s, (math.nan, math.nan)
     return (s[0], s[1], ls[2], s[3], s[4]), dr
 
