@@ -18,7 +18,7 @@ from .model import Model
 from .problem import Problem
 
 __all__ = ['SIZE', 'RIPPLE_PERIODS', 'stops_and_starts', 'smallest_moving_command', 'steady_speeds', 'response_lag',
-           'drive_crossings',
+           'crossings', 'drive_crossings',
            'contradictions', 'unresolved', 'near', 'uncorrected', 'rest_offset', 'no_static_level', 'bound_params',
            'on_bounds', 'untold', 'reversals', 'never_starts']
 
@@ -84,20 +84,26 @@ def response_lag(rec: Record, max_lag: float = 0.1) -> float:
     return int(np.argmax(cc)) * rec.dt
 
 
-def drive_crossings(pr: Problem, model: Model) -> np.ndarray:
-    """Durations [s] of the model's motor side crossing its whole play (from contact on one side
-    to contact on the other: a reversal of the drive force), run along ``pr``'s record
-    (:func:`shooting.drive_states`)."""
+def crossings(side: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The crossings of a drive's whole play in the contact sides ``side`` of each sample (+1 / -1 in
+    contact pushing forward / backward, 0 in the play): the last sample in contact before each and the
+    first one after, on the other side (a reversal of the drive force)."""
+    touch = np.flatnonzero(side != 0.0)
+    before, after = touch[:-1], touch[1:]
+    across = side[before] != side[after]
+    return before[across], after[across]
+
+
+def drive_crossings(pr: Problem, model: Model) -> tuple[np.ndarray, np.ndarray]:
+    """The model's motor side crossing its whole play (:func:`crossings`), run along ``pr``'s record
+    (:func:`shooting.drive_states`): each crossing's samples (from the last contact to the next, 1 where
+    it crosses between two readings) and its duration [s]."""
     rec, vec = pr.rec, model.vectors()
     drive = vec.truth.drive_vector()
     side = shooting.drive_states(vec.pp, drive, rec.t, shooting.applied_commands(vec, rec),
                                  pr.blocks[0][1].motion)[:, 2]
-    touch = np.flatnonzero(side != 0.0)
-    if len(touch) < 2:
-        return np.zeros(0)
-    before, after = touch[:-1], touch[1:]
-    across = side[before] != side[after]
-    return rec.t[after[across]] - rec.t[before[across]]
+    before, after = crossings(side)
+    return after - before, rec.t[after] - rec.t[before]
 
 
 def contradictions(pr: Problem, model: Model, name: str) -> list[str]:
@@ -132,13 +138,13 @@ def contradictions(pr: Problem, model: Model, name: str) -> list[str]:
         if model['drive_backlash_m'] < 2 * rec.x_resolution:
             why.append(f'drive play {model["drive_backlash_m"] * 1e3:.3g} mm is below two encoder counts '
                        f'(quantization)')
-        crossings = drive_crossings(pr, model)
-        if len(crossings) < 3:
-            why.append(f'the motor side crosses its play at {len(crossings)} reversals of the drive force '
+        samples, seconds = drive_crossings(pr, model)
+        if len(samples) < 3:
+            why.append(f'the motor side crosses its play at {len(samples)} reversals of the drive force '
                        f'(needs 3)')
-        elif np.median(crossings) < 2 * rec.dt:
-            why.append(f'the motor side crosses its play in {np.median(crossings) * 1e3:.3g} ms (median over '
-                       f'{len(crossings)} reversals), under two samples: the data cannot show it')
+        elif np.median(samples) < 2:
+            why.append(f'the motor side crosses its play in {np.median(seconds) * 1e3:.3g} ms (median over '
+                       f'{len(samples)} reversals), between two readings: the data cannot show it')
     return why
 
 
