@@ -172,6 +172,8 @@ def test_free_constant_is_refitted_only_when_asked(tmp_path, clean, capsys):
     assert main(['identify', str(csv), '--base', 'coulomb', '--free', 'M', '--out', str(tmp_path / 'rep'),
                  '--json', '--no-plots']) == 0
     r = json.loads(capsys.readouterr().out)
+    assert [s['step'] for s in r['ladder']][:2] == ['declared', 'refit'], r['ladder'][0]['notes']
+    assert not {p['name']: p for p in r['ladder'][0]['params']}['M']['fitted']     # declared, not fitted
     m = {p['name']: p for p in r['ladder'][1]['params']}['M']
     assert m['fitted'] and m['value'] == pytest.approx(PLANT.M, rel=0.03)
     # the cart alone fixes M / alpha only: the same motion read as alpha, M held as declared

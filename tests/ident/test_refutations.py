@@ -8,7 +8,7 @@ from independent import rigsim
 
 from ipfric_core.analysis.records import load
 from ipfric_core.ident.model import load_declared
-from ipfric_core.ident.refutations import crossings, never_starts, reversals, stops_and_starts
+from ipfric_core.ident.refutations import crossings, never_starts, reversals, stops_and_starts, unseen
 
 
 def test_a_static_friction_no_command_overcomes_refutes_the_model(tmp_path):
@@ -116,3 +116,6 @@ def test_a_crossing_of_a_drive_play_is_counted_in_readings():
     assert before.tolist() == [2, 5, 11, 12] and after.tolist() == [4, 8, 12, 16]
     assert (after - before).tolist() == [2, 3, 1, 4]
     assert [len(a) for a in crossings(np.zeros(5))] == [0, 0] and [len(a) for a in crossings(np.ones(1))] == [0, 0]
+    # the rule: a reading in the play at the median crossing, whatever the span's time (it takes none)
+    assert unseen(np.array([1, 1, 2])) and unseen(np.array([1, 1, 1, 2, 3, 3]))
+    assert not unseen(np.array([2, 2, 1])) and not unseen(np.array([1, 2, 3, 2]))

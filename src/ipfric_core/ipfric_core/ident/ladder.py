@@ -8,11 +8,12 @@ the declared model as it is; then, round by round until the validation error is 
 reach of what the encoders' rounding alone leaves (:func:`~ipfric_core.ident.judging.verdict`) or nothing
 passes, every hypothesis competes against the current model (:mod:`ipfric_core.ident.hypotheses`): its
 friction refitted (known constants frozen unless freed by name: a freed one is fitted first, whatever the
-verdict), each other friction law (viscous, coulomb, exponential, dynamic with its bristle
-starts), each plant correction (M, alpha: a wrong back-EMF beta is the viscous slope eps's to take,
-F = alpha V - (beta + eps) x'), each library effect with the friction levels
-refitted and, before any refit, on the declared friction alone. A round keeps the one that
-lowers the validation error most among those that pass every check (:mod:`ipfric_core.ident.judging`,
+verdict, and that fit is refused as any other is when a parameter ends on its bound, its Coulomb level is
+not told from zero or its static friction never lets the cart start), each other friction law
+(viscous, coulomb, exponential, dynamic with its bristle starts), each plant correction (M, alpha: a
+wrong back-EMF beta is the viscous slope eps's to take, F = alpha V - (beta + eps) x'), each library
+effect with the friction levels refitted and, before any refit, on the declared friction alone. A round
+keeps the one that lowers the validation error most among those that pass every check (:mod:`ipfric_core.ident.judging`,
 :func:`confirm`).
 
 Each round, every candidate first gets a short fit, and only the most promising ones are fitted in full
@@ -137,13 +138,14 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
     say = progress or (lambda msg: None)
     pe, pv = Problem(est), Problem(val)
     current = declared
-    steps = [Step('declared', declared, {}, pe.summary(declared), pv.summary(declared), [])]
+    steps = [Step('declared', declared.holding({p.name: p.value for p in declared.free}), {},
+                  pe.summary(declared), pv.summary(declared), [])]
     say(f'declared model: validation x error {steps[0].val["x_rms_counts"]:.3g} counts')
-    if declared.free:        # constants the user asked to fit (--free): fitted with the law first, whatever the verdict
+    if declared.free:        # constants the user asked to fit (--free): fitted with the law first, then checked
         law = LAW_PARAMS[declared.law]
         fitted, s = fit_model(pe, declared.with_free(law), prior=declared)
         names = ', '.join(p.name for p in declared.free)
-        refuted = on_bounds(fitted) + never_starts(pe.rec, fitted)
+        refuted = on_bounds(fitted) + untold(fitted, s) + never_starts(pe.rec, fitted)
         if refuted:
             steps[0].notes.append(f'the refit of the {declared.law} law with {names} (--free) is refuted: '
                                   + '; '.join(refuted) + '; the rounds start from the declared values, '
