@@ -22,7 +22,7 @@ from . import shooting
 from .hypotheses import Hypothesis
 from .model import LAW_PARAMS, Model
 from .problem import Problem, block_p_value
-from .refutations import contradictions, never_starts, on_bounds
+from .refutations import contradictions, unfit
 
 __all__ = ['WORSE_PERCENT', 'contribution', 'Judged', 'judge', 'drop_checks', 'beyond_refit', 'leaner_first',
            'verdict']
@@ -77,7 +77,7 @@ def judge(pe: Problem, pv: Problem, current: Model, h: Hypothesis, m: Model, not
     ev1 = pv.cost(m)
     ee0, ee1 = pe.cost(current), pe.cost(m)
     gain, pval, dropped = drop_checks(pv, current, m, sse0_v)
-    why = ([note] if note else []) + on_bounds(m) + never_starts(pe.rec, m)
+    why = ([note] if note else []) + unfit(pe.rec, m)
     if h.effect and not (note or '').startswith('its short fit: '):
         why += contradictions(pe, m, h.effect)
     why += dropped

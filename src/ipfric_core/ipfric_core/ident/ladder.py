@@ -32,7 +32,7 @@ from .hypotheses import PLANT_CORRECTIONS, Hypothesis, errors_of, full_fit, hypo
 from .judging import WORSE_PERCENT, Judged, beyond_refit, contribution, judge, leaner_first, verdict
 from .model import FRICTION_FITTED, LAW_PARAMS, Model
 from .problem import Problem, fit_model
-from .refutations import near, never_starts, on_bounds, uncorrected, unresolved, untold
+from .refutations import near, uncorrected, unfit, unresolved, untold
 from .starts import DRIVE_GRID, balance_starts
 
 __all__ = ['Step', 'run_ladder']
@@ -145,7 +145,7 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
         law = LAW_PARAMS[declared.law]
         fitted, s = fit_model(pe, declared.with_free(law), prior=declared)
         names = ', '.join(p.name for p in declared.free)
-        refuted = on_bounds(fitted) + untold(fitted, s) + never_starts(pe.rec, fitted)
+        refuted = unfit(pe.rec, fitted, s)
         if refuted:
             steps[0].notes.append(f'the refit of the {declared.law} law with {names} (--free) is refuted: '
                                   + '; '.join(refuted) + '; the rounds start from the declared values, '
@@ -202,8 +202,7 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
             break
         win = ok[0]
         current, s = fit_model(pe, win.model, max_nfev=60, prior=declared)   # every fitted parameter together
-        if on_bounds(current) or untold(current, s) or never_starts(pe.rec, current) \
-                or pv.cost(current) > pv.cost(win.model):
+        if unfit(pe.rec, current, s) or pv.cost(current) > pv.cost(win.model):
             current, s = win.model, win.std
         label = {'friction': 'refit', 'law': win.h.label, 'plant': win.h.label}.get(win.h.kind, f'+ {win.h.effect}')
         step_notes = correction_notes(declared, current, s, est.theta is None) if win.h.kind == 'plant' else []
@@ -242,7 +241,7 @@ def take_back(pe: Problem, pv: Problem, declared: Model, current: Model, candida
     (:func:`undo_corrections`, :func:`drop_spent`)."""
     m, s = fit_model(pe, candidate, prior=declared)
     before, after = pv.summary(current)['x_rms_counts'], pv.summary(m)['x_rms_counts']
-    if after > before * (1 + WORSE_PERCENT / 100) or on_bounds(m) or never_starts(pe.rec, m):
+    if after > before * (1 + WORSE_PERCENT / 100) or unfit(pe.rec, m):
         return current
     note += f' (validation error {after:.3g} counts, {before:.3g} before; within {WORSE_PERCENT:g} %)'
     steps.append(Step(label, m, s, pe.summary(m), pv.summary(m), [note]))

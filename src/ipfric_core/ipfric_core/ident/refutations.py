@@ -20,7 +20,7 @@ from .problem import Problem
 __all__ = ['SIZE', 'RIPPLE_PERIODS', 'stops_and_starts', 'smallest_moving_command', 'steady_speeds', 'response_lag',
            'crossings', 'unseen', 'drive_crossings',
            'contradictions', 'unresolved', 'near', 'uncorrected', 'rest_offset', 'no_static_level', 'bound_params',
-           'on_bounds', 'untold', 'reversals', 'never_starts']
+           'on_bounds', 'untold', 'reversals', 'never_starts', 'unfit']
 
 UNDO_SIGMA = 2.0         # a correction that ends this many standard errors from the declared value or closer is undone
 STOP_S = 0.05            # a stretch this long with the encoder still is a stop [s]
@@ -312,3 +312,10 @@ def never_starts(rec: Record, model: Model) -> list[str]:
                     f't = {rec.t[still]:.4g} s (at most {push(volts):.4g} N within {BREAKAWAY_S:g} s: commands up '
                     f'to {volts:.4g} V), yet the cart started from rest there and travelled three counts']
     return []
+
+
+def unfit(rec: Record, model: Model, std: dict | None = None) -> list[str]:
+    """Why a fitted ``model`` cannot stand as a step, whatever its error: a parameter on its bound
+    (:func:`on_bounds`), a Coulomb level not told from zero by its standard errors ``std`` (:func:`untold`;
+    not checked without them) and a static friction that never lets the cart start (:func:`never_starts`)."""
+    return on_bounds(model) + (untold(model, std) if std else []) + never_starts(rec, model)
