@@ -105,6 +105,22 @@ def test_a_static_friction_the_drive_did_not_overcome_at_a_start_refutes_the_mod
     assert len(why) == 1 and f't = {rec.t[weakest]:.4g} s' in why[0] and f'{volts:.4g} V' in why[0], why
 
 
+def test_stale_readings_after_an_overrun_are_no_stop(tmp_path):
+    """A sample overrun repeats the reading before (marked invalid on loading): frozen so for 60 ms in
+    motion, the cart has not stopped and started again; a stop is read on the valid readings."""
+    from ipfric_core.ident.refutations import STOP_S
+    rec = load(rigsim.write_case('cart_none', tmp_path, duration=20.0), None)
+    before = stops_and_starts(rec)
+    speed = np.abs(np.gradient(rec.x, rec.t))
+    k = int(np.argmax(speed))                            # the fastest reading: moving, far from a stop
+    n = int(np.ceil(1.2 * STOP_S / rec.dt))
+    x, valid = rec.x.copy(), rec.valid_mask.copy()
+    x[k + 1:k + 1 + n], valid[k + 1:k + 1 + n] = x[k], False
+    stale = replace(rec, x=x, valid=valid)
+    assert stops_and_starts(replace(stale, valid=None)) != before      # read as readings, a stop appears
+    assert stops_and_starts(stale) == before
+
+
 def test_a_crossing_of_a_drive_play_is_counted_in_readings():
     """The motor side's crossings of its play, from its contact side at each reading: a reversal of the
     contact (forward to backward or back) is one, however many readings in the play between; a return to

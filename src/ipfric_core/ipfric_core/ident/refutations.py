@@ -34,13 +34,16 @@ MIN_CLIPPED = 0.001
 
 
 def stops_and_starts(rec: Record) -> list[tuple[int, int]]:
-    """(last still sample, first moving sample) of every breakaway after a stop of STOP_S."""
-    x, t = rec.x, rec.t
+    """(last still sample, first moving sample) of every breakaway after a stop of STOP_S, read on the
+    valid readings (the stale ones after a sample overrun repeat the reading before: a cart frozen so for
+    60 ms of a 10 ms loop has not stopped)."""
+    keep = np.flatnonzero(rec.valid_mask)
+    x, t = rec.x[keep], rec.t[keep]
     moves = np.flatnonzero(np.diff(x) != 0.0)
     out = []
     for a, b in zip(moves[:-1], moves[1:]):
         if t[b] - t[a + 1] >= STOP_S:
-            out.append((int(b), int(b) + 1))
+            out.append((int(keep[b]), int(keep[b + 1])))
     return out
 
 
