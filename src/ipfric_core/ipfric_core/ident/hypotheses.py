@@ -137,11 +137,8 @@ def hypotheses(pe: Problem, current: Model, declared: Model, allowed=None, balan
     return out
 
 
-#: the plays [m] of a drive in place of a mass correction (a play the mass explained is a small one: from
-#: 0.03 mm, about two counts of the usual encoders, a third of the campaign's log-uniform draw of 5 um to 3 mm
-#: lies below 0.05 mm; seed 2027's case 74, a 0.039 mm play, from 0.1 mm ended at 0.11 mm and was not
-#: significant, p = 0.10, from 0.03 mm at 0.023 mm, p = 0.0005)
-IN_PLACE_GAPS = (3e-5, 1e-4, 3e-4, 1e-3)
+#: the plays [m] of a drive in place of a mass correction (a play the mass explained is a small one)
+IN_PLACE_GAPS = (1e-4, 3e-4, 1e-3)
 
 
 def in_place_of_mass(pe: Problem, current: Model, declared: Model, levels: tuple) -> Hypothesis:
