@@ -4,9 +4,10 @@ import pytest
 from independent import rigsim
 
 from ipfric_core.analysis.records import load
-from ipfric_core.ident.judging import verdict
+from ipfric_core.ident.judging import rounding_model, verdict
 from ipfric_core.ident.model import load_declared
 from ipfric_core.ident.problem import Problem
+from ipfric_core.ident.shooting import quantization_floor
 
 
 def test_the_floor_is_a_share_of_the_measured_motion_even_for_a_model_that_hardly_moves(tmp_path):
@@ -23,3 +24,23 @@ def test_the_floor_is_a_share_of_the_measured_motion_even_for_a_model_that_hardl
     assert got['stuck']['unexplained_percent'] > 50       # most of the motion left ...
     assert got['stuck']['floor_percent'] < 5              # ... beside a rounding that leaves a few %, not a share
     assert not got['stuck']['explained']                 # of the little the model moves
+
+
+def test_a_play_no_sensor_reads_does_not_raise_the_floor(tmp_path):
+    """The floor is what the encoders' rounding leaves, not the error of starting a play's hidden position
+    from an estimate: a model with a 30 mm encoder play and one with a drive play are judged against the
+    floor of the same model with the play closed (the drive's motor side then moves with the cart)."""
+    rec = load(rigsim.write_case('cart_none', tmp_path, duration=20.0), None)
+    pv = Problem(rec.split(0.6)[1])
+    model = load_declared(None, 'exponential', pendulum=False)
+    loose = model.with_effect('backlash', {'backlash_m': 0.03})
+    win = pv.blocks[0][1]
+    own = quantization_floor(loose.vectors(), pv.rec, win, 'x')['x_floor_counts']
+    plain = verdict(pv, model)['floor_counts']
+    assert own > 3 * plain                                   # the play's start estimate, not rounding
+    assert verdict(pv, loose)['floor_counts'] == pytest.approx(plain, rel=1e-9)
+    drive = model.with_effect('drive_backlash', {'drive_backlash_m': 1e-3, 'drive_mass_kg': 0.2,
+                                                 'drive_stiffness_N_per_m': 1e5, 'drive_damping_Ns_per_m': 20.0})
+    closed = rounding_model(drive)
+    assert closed['drive_backlash_m'] == 0.0 and closed['M'] == pytest.approx(model['M'] + 0.2)
+    assert rounding_model(model) == model
