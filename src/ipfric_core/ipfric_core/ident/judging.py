@@ -22,7 +22,7 @@ from . import shooting
 from .hypotheses import Hypothesis
 from .model import LAW_PARAMS, Model
 from .problem import Problem, block_p_value
-from .refutations import contradictions, unfit
+from .refutations import SIZE, contradictions, unfit
 
 __all__ = ['WORSE_PERCENT', 'contribution', 'Judged', 'judge', 'drop_checks', 'beyond_refit', 'leaner_first',
            'rounding_model', 'verdict']
@@ -36,8 +36,8 @@ WORSE_COUNTS = 0.5       # and by more than this [counts RMS]: an angle error ne
 #: leaves, plus this many counts
 EXPLAINED_FACTOR = 1.5
 EXPLAINED_SLACK = 0.3
-#: the effects with a state no sensor reads, and the parameter that closes each (:func:`rounding_model`)
-HIDDEN = {'backlash': 'backlash_m', 'drive_backlash': 'drive_backlash_m'}
+#: the effects with a state no sensor reads (a play's position), closed by their size at zero (:func:`rounding_model`)
+HIDDEN = ('backlash', 'drive_backlash')
 
 
 def contribution(parts: tuple[Problem, ...], model: Model, without: Model) -> float:
@@ -159,7 +159,7 @@ def rounding_model(model: Model) -> Model:
     position is a state no sensor reads, and the windows start it from an estimate: with it, the floor
     held that estimate's error too (a real cart's log fitted with a 68 mm encoder play had a floor of
     46.5 % of the motion, and its 5.86 % left was called explained; with the play closed, 0.501 %)."""
-    closed = {HIDDEN[e]: 0.0 for e in model.effects if e in HIDDEN}
+    closed = {n: 0.0 for e in model.effects if e in HIDDEN for n in SIZE[e]}
     if 'drive_backlash' in model.effects:
         closed['M'] = model['M'] + model['drive_mass_kg']
     return model.with_values(closed)
