@@ -18,6 +18,9 @@ The answer given: ``result['effects_added']`` (the friction law's parts ``coulom
 ``presliding`` are not effects) and ``result['constants_corrected']``; without either,
 ``not_explained`` when its verdict says so, else ``none``.
 
+On the clean cases the summary also checks the final friction levels' reported standard errors against
+the truth (``coverage``: the median |fit - truth| / std and the share within two of them, per experiment).
+
 Writes out_dir/summary.json, summary.md and detection.png; out_dir/cases/<case>/ holds the data,
 the truth and the identification's report (``ident/result.json``, ``ident/stderr.txt``).
 """
@@ -313,10 +316,52 @@ def score_case(truth: dict, ident: dict, threshold: float = THRESHOLD, generatio
         components=components(truth, threshold), expected=exp['label'], expected_detail=exp,
         predicted=pred['label'], added=pred['added'], verdict=pred['verdict'],
         outcome=outcome(exp, pred), validation_counts=ladder, oracle_counts=oracle_counts,
+        friction_z=friction_z(truth, ident.get('result')),
         wall_s=ident.get('wall_s'),
         generation_s=generation_s if generation_s is not None else truth.get('generation_s'),
         rc=ident.get('rc'), stderr_tail=ident.get('stderr_tail'),
         command=ident.get('command'))
+
+
+#: the friction levels whose standard errors are checked against the truth: the generator's law is the
+#: exponential Stribeck curve (gamma 2), the ladder's 'exponential'; a final model with another law (its
+#: levels mean other things) is not checked
+LEVELS = ('Fc', 'Fs_excess', 'eps', 'v_s')
+#: the share of the levels a standard error must cover within two of them (a normal error: 95 %)
+COVERED = 2.0
+
+
+def friction_z(truth: dict, result: dict | None) -> dict:
+    """The final model's friction levels off the truth in their standard errors, (fit - truth) / std, where the
+    final law is the generator's (every level of LEVELS fitted, no other friction parameter) and a level has a
+    finite standard error; {} otherwise."""
+    if not result or not result.get('ladder'):
+        return {}
+    params = {p['name']: p for p in result['ladder'][-1]['params']}
+    if {n for n in params if n in LEVELS or n in ('sigma0', 'sigma1')} != set(LEVELS):
+        return {}
+    out = {}
+    for n in LEVELS:
+        p = params[n]
+        s = p.get('std')
+        if p.get('fitted') and s is not None and math.isfinite(s) and s > 0:
+            out[n] = (p['value'] - truth['friction'][n]) / s
+    return out
+
+
+def coverage(cases: list[dict]) -> dict:
+    """How well the reported standard errors of the friction levels cover the truth on the clean cases (where
+    the levels are the whole truth): per experiment and over all, the levels checked, the median |z| (0.67 for
+    honest normal errors) and the share within COVERED standard errors (0.95)."""
+    groups: defaultdict[str, list] = defaultdict(list)
+    for c in cases:
+        if c['components'] or not c.get('friction_z'):
+            continue
+        z = [abs(v) for v in c['friction_z'].values()]
+        groups[c['experiment']] += z
+        groups['all'] += z
+    return {k: dict(n=len(z), median_abs_z=float(np.median(z)), within=float(np.mean(np.array(z) <= COVERED)))
+            for k, z in sorted(groups.items())}
 
 
 def detection_limit(points: list[tuple[float, bool]], share: float = 0.95, least: int = 3):
@@ -381,7 +426,7 @@ def summarize(cases: list[dict], threshold: float, meta: dict) -> dict:
                    not_explained=sum(1 for c in clean if c['predicted'] == 'not_explained'),
                    share_anything_added=(sum(1 for c in clean if c['added']) / len(clean)) if clean else None,
                    added=dict(Counter(c['predicted'] for c in clean if c['added']))),
-        per_effect=rates, by_setting=by_setting,
+        per_effect=rates, by_setting=by_setting, coverage=coverage(cases),
         timing=dict(identify_wall_s_mean=float(np.mean(walls)) if walls else None,
                     identify_wall_s_median=float(np.median(walls)) if walls else None,
                     identify_wall_s_max=float(np.max(walls)) if walls else None,
@@ -458,6 +503,13 @@ def write_markdown(s: dict, path: Path) -> None:
     for k, v in s['by_setting'].items():
         L.append(f'| {k} | {v["n"]} | {v["right"]} | ' + ', '.join(f'{a} {b}' for a, b in sorted(v['outcomes'].items()))
                  + f' | {_fmt(v["true_model_counts_median"])} |')
+    if s.get('coverage'):
+        L += ['', '## Standard errors against the truth (clean cases)', '',
+              f'The final friction levels ({", ".join(LEVELS)}) off the truth in their reported standard errors: '
+              f'honest normal errors give a median |z| of 0.67 and 95 % within {COVERED:g} of them.', '',
+              '| experiment | levels | median abs(z) | within 2 std |', '|---|---|---|---|']
+        for k, v in s['coverage'].items():
+            L.append(f'| {k} | {v["n"]} | {v["median_abs_z"]:.2f} | {100 * v["within"]:.0f} % |')
     t = s['timing']
     L += ['', '## Time', '',
           f'Identification wall time per case: mean {_fmt(t["identify_wall_s_mean"])} s, median '

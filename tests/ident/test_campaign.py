@@ -200,6 +200,29 @@ def test_a_drive_whose_play_is_not_seen_expects_the_mass_of_its_motor_side():
     assert scorer.expected_answer(tiny, 2.0)['label'] == 'drive_backlash'
 
 
+def test_standard_errors_are_checked_against_the_truth_on_clean_cases():
+    truth = {'friction': {'Fc': 0.5, 'Fs_excess': 0.2, 'eps': 3.0, 'v_s': 0.1}}
+
+    def result(values, stds, law=('Fc', 'Fs_excess', 'eps', 'v_s')):
+        params = [{'name': 'M', 'value': 1.0, 'std': None, 'fitted': False}]
+        params += [{'name': n, 'value': values[n], 'std': stds.get(n), 'fitted': n in stds} for n in law]
+        return {'ladder': [{'params': params}]}
+    z = scorer.friction_z(truth, result({'Fc': 0.53, 'Fs_excess': 0.2, 'eps': 2.0, 'v_s': 0.1},
+                                        {'Fc': 0.01, 'eps': 0.25, 'v_s': math.inf}))
+    assert z == pytest.approx({'Fc': 3.0, 'eps': -4.0})        # Fs_excess held, v_s without an error
+    # another law's levels mean other things: not checked
+    assert scorer.friction_z(truth, result(truth['friction'], {'Fc': 0.1}, ('Fc', 'Fs_excess', 'eps'))) == {}
+    assert scorer.friction_z(truth, None) == {}
+    cases = [{'components': [], 'experiment': 'loop', 'friction_z': {'Fc': 3.0, 'eps': -1.0}},
+             {'components': [], 'experiment': 'cart', 'friction_z': {'Fc': 0.5, 'eps': 0.3}},
+             {'components': [{'name': 'offset'}], 'experiment': 'cart', 'friction_z': {'Fc': 9.0}},   # not clean
+             {'components': [], 'experiment': 'cart', 'friction_z': {}}]
+    cov = scorer.coverage(cases)
+    assert set(cov) == {'all', 'cart', 'loop'}
+    assert cov['loop'] == {'n': 2, 'median_abs_z': 2.0, 'within': 0.5}
+    assert cov['cart']['within'] == 1.0 and cov['all']['n'] == 4
+
+
 def test_a_deadzone_counts_by_what_a_friction_level_cannot_take_over():
     def dz(total, beyond):
         truth = _truth((('deadzone', total),))
