@@ -135,3 +135,32 @@ def test_a_crossing_of_a_drive_play_is_counted_in_readings():
     # the rule: a reading in the play at the median crossing, whatever the span's time (it takes none)
     assert unseen(np.array([1, 1, 2])) and unseen(np.array([1, 1, 1, 2, 3, 3]))
     assert not unseen(np.array([2, 2, 1])) and not unseen(np.array([1, 2, 3, 2]))
+
+
+def _through_play(x: np.ndarray, play: float, count: float) -> np.ndarray:
+    """Readings of a cart at ``x`` [m] taken through an encoder play [m], in whole counts (this test's own
+    formula: the reading moves only where the cart pushes an edge of the play)."""
+    r = np.empty_like(x)
+    r[0] = x[0]
+    for k in range(1, len(x)):
+        r[k] = min(max(r[k - 1], x[k] - 0.5 * play), x[k] + 0.5 * play)
+    return count * np.round(r / count)
+
+
+@pytest.mark.parametrize('case, play_counts', [('cart_none', 3), ('cart_none', 100), ('loop_none', 20)])
+def test_an_encoder_play_is_at_most_what_the_cart_crosses_while_its_readings_turn(tmp_path, case, play_counts):
+    """Behind a play the readings stand while the cart turns and crosses it, no faster than the cart ever
+    moves: readings taken through a true play allow it, and a play wider than the turns allow is refuted (a
+    real cart's log was fitted with a 68 mm play where its readings turned within 20 ms at 0.9 m/s at most)."""
+    from ipfric_core.ident.problem import Problem
+    from ipfric_core.ident.refutations import contradictions, widest_play
+    rec = load(rigsim.write_case(case, tmp_path, duration=20.0), None)
+    q = rec.x_resolution
+    played = replace(rec, x=_through_play(rec.x, play_counts * q, q))
+    limit, turn, fastest = widest_play(played)
+    assert limit >= play_counts * q                     # a true play is never refuted
+    model = load_declared(None, 'exponential', pendulum=rec.theta is not None).with_effect('backlash')
+    pr = Problem(played)
+    assert contradictions(pr, model.with_values({'backlash_m': play_counts * q}), 'backlash') == []
+    why = contradictions(pr, model.with_values({'backlash_m': 1.01 * limit}), 'backlash')
+    assert len(why) == 1 and f'within {turn * 1e3:.3g} ms' in why[0] and f'{fastest:.3g} m/s' in why[0], why

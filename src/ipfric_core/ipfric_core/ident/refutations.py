@@ -18,7 +18,7 @@ from .model import Model
 from .problem import Problem
 
 __all__ = ['SIZE', 'RIPPLE_PERIODS', 'stops_and_starts', 'smallest_moving_command', 'steady_speeds', 'response_lag',
-           'crossings', 'unseen', 'drive_crossings',
+           'crossings', 'unseen', 'drive_crossings', 'widest_play',
            'contradictions', 'unresolved', 'near', 'uncorrected', 'rest_offset', 'no_static_level', 'bound_params',
            'on_bounds', 'untold', 'reversals', 'never_starts', 'unfit']
 
@@ -31,6 +31,8 @@ RIPPLE_PERIODS = 2.0
 #: the least share of the commands a saturation clips: an amplifier limit the commands reach 0.37 % of the time
 #: moved a cart by 15 counts RMS (seed 2027, case 50, refused at 1 %); below it, a handful of peaks
 MIN_CLIPPED = 0.001
+#: the span [s] over which the readings' fastest speed is taken (:func:`widest_play`)
+SPEED_SPAN_S = 0.02
 
 
 def stops_and_starts(rec: Record) -> list[tuple[int, int]]:
@@ -117,6 +119,27 @@ def drive_crossings(pr: Problem, model: Model) -> tuple[np.ndarray, np.ndarray]:
     return after - before, rec.t[after] - rec.t[before]
 
 
+def widest_play(rec: Record) -> tuple[float, float, float] | None:
+    """The widest encoder play [m] the readings allow, with the median time [s] over which they turn and the
+    fastest speed [m/s] they show (over SPEED_SPAN_S): behind a play the encoder reads nothing new once the
+    cart turns, until it has crossed the play, and the cart crosses it no faster than it ever moves; so each
+    turn of the readings (from their last change one way to their first change the other) lasts at least the
+    play over that speed. The play allowed is that speed times the median turn, plus two counts of rounding
+    (a real cart's log was fitted with a 68 mm play where its readings turned within 20 ms at a median turn
+    and never moved faster than 0.9 m/s: 18 mm at most). On the valid readings; None where they turn fewer
+    than three times."""
+    keep = rec.valid_mask
+    x, t = rec.x[keep], rec.t[keep]
+    moves = np.flatnonzero(np.diff(x) != 0.0)
+    turns = np.flatnonzero(np.diff(np.sign(np.diff(x)[moves])) != 0.0)
+    if len(turns) < 3:
+        return None
+    turn = float(np.median(t[moves[turns + 1] + 1] - t[moves[turns]]))
+    n = max(1, int(round(SPEED_SPAN_S / rec.dt)))
+    fastest = float(np.max(np.abs(x[n:] - x[:-n]) / (t[n:] - t[:-n])))
+    return fastest * turn + 2 * rec.x_resolution, turn, fastest
+
+
 def contradictions(pr: Problem, model: Model, name: str) -> list[str]:
     """Why the data refute the fitted effect ``name`` (empty when nothing does)."""
     rec = pr.rec
@@ -143,8 +166,14 @@ def contradictions(pr: Problem, model: Model, name: str) -> list[str]:
     if name == 'cogging' and np.ptp(rec.x) < RIPPLE_PERIODS * model['cogging_period_m']:
         why.append(f'cogging period {model["cogging_period_m"] * 1e3:.3g} mm: fewer than {RIPPLE_PERIODS:g} periods '
                    f'over the travel ({np.ptp(rec.x) * 1e3:.3g} mm)')
-    if name == 'backlash' and model['backlash_m'] < 2 * rec.x_resolution:
-        why.append(f'play {model["backlash_m"] * 1e3:.3g} mm is below two encoder counts (quantization)')
+    if name == 'backlash':
+        limit = widest_play(rec)
+        if model['backlash_m'] < 2 * rec.x_resolution:
+            why.append(f'play {model["backlash_m"] * 1e3:.3g} mm is below two encoder counts (quantization)')
+        elif limit is not None and model['backlash_m'] > limit[0]:
+            why.append(f'play {model["backlash_m"] * 1e3:.3g} mm: the readings turn within {limit[1] * 1e3:.3g} ms '
+                       f'(median of their turns) and never move faster than {limit[2]:.3g} m/s, so the encoder '
+                       f'crosses {limit[0] * 1e3:.3g} mm at most')
     if name == 'drive_backlash':
         if model['drive_backlash_m'] < 2 * rec.x_resolution:
             why.append(f'drive play {model["drive_backlash_m"] * 1e3:.3g} mm is below two encoder counts '
