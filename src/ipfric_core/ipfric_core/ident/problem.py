@@ -28,7 +28,7 @@ MAX_NFEV = 40
 DIFF_STEP = 5e-3
 THETA_WEIGHT = 0.2       # an angle count weighs a fifth of a cart count (errors of the pendulum's start rates grow)
 PRIOR_REL = 0.5         # the declared values' prior standard deviation, relative
-PRIOR_COUNTS = 0.3      # RMS error [counts] over one window's samples that one prior standard deviation is worth
+PRIOR_COUNTS = 0.3      # RMS error [counts] that one prior standard deviation is worth
 #: the candidates' short fits use windows spread over the estimation record, up to this many samples per
 #: block (a 2-minute record at 1 kHz: every seventh window); the kept explanation is refitted on all
 SCREEN_SAMPLES = 10000
@@ -132,8 +132,7 @@ def fit_model(pr: Problem, model: Model, max_nfev: int = MAX_NFEV, only=None, pr
 
     ``prior``: the declared model; each of its free values enters as a prior (standard
     deviation PRIOR_REL of its size; one standard deviation costs as much as PRIOR_COUNTS of
-    RMS error over one window's samples: the windows, not the samples, are the independent evidence, as
-    in :func:`block_covariance`), so that a direction the data hardly determine
+    RMS error on every compared sample), so that a direction the data hardly determine
     (Coulomb level against viscous slope at the low speeds of a limit cycle) stays at the
     declared value instead of wandering to a bound. The Jacobian is differenced sparingly
     (:func:`lsq.solve`)."""
@@ -149,7 +148,7 @@ def fit_model(pr: Problem, model: Model, max_nfev: int = MAX_NFEV, only=None, pr
     anchored = [i for i, nm in enumerate(names) if nm in ref]
     z0 = np.array([ref[names[i]] for i in anchored]) / scale[anchored] if anchored else np.zeros(0)
     sd = PRIOR_REL * np.maximum(np.abs(z0), np.array([PARAMS[names[i]].typical for i in anchored]) / scale[anchored])
-    weight = PRIOR_COUNTS * math.sqrt(pr.n_samples / pr.n_windows)
+    weight = PRIOR_COUNTS * math.sqrt(pr.n_samples)
     lin_jac = np.zeros((len(anchored), len(names)))
     lin_jac[np.arange(len(anchored)), anchored] = weight / sd
 
