@@ -323,25 +323,25 @@ def score_case(truth: dict, ident: dict, threshold: float = THRESHOLD, generatio
         command=ident.get('command'))
 
 
-#: the friction levels whose standard errors are checked against the truth: the generator's law is the
-#: exponential Stribeck curve (gamma 2), the ladder's 'exponential'; a final model with another law (its
-#: levels mean other things) is not checked
-LEVELS = ('Fc', 'Fs_excess', 'eps', 'v_s')
+#: the ladder's law that is the generator's (the exponential Stribeck curve, gamma 2): the friction levels of a
+#: final model with another law mean other things and are not checked against the truth
+LAW = 'exponential'
 #: the share of the levels a standard error must cover within two of them (a normal error: 95 %)
 COVERED = 2.0
 
 
 def friction_z(truth: dict, result: dict | None) -> dict:
     """The final model's friction levels off the truth in their standard errors, (fit - truth) / std, where the
-    final law is the generator's (every level of LEVELS fitted, no other friction parameter) and a level has a
-    finite standard error; {} otherwise."""
+    final law is the generator's (the friction parameters of LAW, no other) and a level has a finite standard
+    error; {} otherwise."""
+    from ipfric_core.ident.model import FRICTION_FITTED, LAW_PARAMS
     if not result or not result.get('ladder'):
         return {}
     params = {p['name']: p for p in result['ladder'][-1]['params']}
-    if {n for n in params if n in LEVELS or n in ('sigma0', 'sigma1')} != set(LEVELS):
+    if set(params) & set(FRICTION_FITTED) != set(LAW_PARAMS[LAW]):
         return {}
     out = {}
-    for n in LEVELS:
+    for n in LAW_PARAMS[LAW]:
         p = params[n]
         s = p.get('std')
         if p.get('fitted') and s is not None and math.isfinite(s) and s > 0:
@@ -505,7 +505,7 @@ def write_markdown(s: dict, path: Path) -> None:
                  + f' | {_fmt(v["true_model_counts_median"])} |')
     if s.get('coverage'):
         L += ['', '## Standard errors against the truth (clean cases)', '',
-              f'The final friction levels ({", ".join(LEVELS)}) off the truth in their reported standard errors: '
+              f'The final friction levels of the {LAW} law off the truth in their reported standard errors: '
               f'honest normal errors give a median |z| of 0.67 and 95 % within {COVERED:g} of them.', '',
               '| experiment | levels | median abs(z) | within 2 std |', '|---|---|---|---|']
         for k, v in s['coverage'].items():

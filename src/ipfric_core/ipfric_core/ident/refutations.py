@@ -17,7 +17,8 @@ from .effects import PARAMS, static_level
 from .model import Model
 from .problem import Problem
 
-__all__ = ['SIZE', 'RIPPLE_PERIODS', 'stops_and_starts', 'smallest_moving_command', 'steady_speeds', 'response_lag',
+__all__ = ['SIZE', 'RIPPLE_PERIODS', 'valid_moves', 'stops_and_starts', 'smallest_moving_command', 'steady_speeds',
+           'response_lag',
            'crossings', 'unseen', 'drive_crossings', 'widest_play',
            'contradictions', 'unresolved', 'near', 'uncorrected', 'rest_offset', 'no_static_level', 'bound_params',
            'on_bounds', 'untold', 'reversals', 'never_starts', 'unfit']
@@ -35,13 +36,19 @@ MIN_CLIPPED = 0.001
 SPEED_SPAN_S = 0.02
 
 
-def stops_and_starts(rec: Record) -> list[tuple[int, int]]:
-    """(last still sample, first moving sample) of every breakaway after a stop of STOP_S, read on the
-    valid readings (the stale ones after a sample overrun repeat the reading before: a cart frozen so for
-    60 ms of a 10 ms loop has not stopped)."""
+def valid_moves(rec: Record) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The valid readings (the stale ones after a sample overrun repeat the reading before): their sample
+    indices, positions [m], stamps [s], and the positions among them after which the reading changes."""
     keep = np.flatnonzero(rec.valid_mask)
     x, t = rec.x[keep], rec.t[keep]
-    moves = np.flatnonzero(np.diff(x) != 0.0)
+    return keep, x, t, np.flatnonzero(np.diff(x) != 0.0)
+
+
+def stops_and_starts(rec: Record) -> list[tuple[int, int]]:
+    """(last still sample, first moving sample) of every breakaway after a stop of STOP_S, read on the
+    valid readings (:func:`valid_moves`: a cart frozen by overruns for 60 ms of a 10 ms loop has not
+    stopped)."""
+    keep, x, t, moves = valid_moves(rec)
     out = []
     for a, b in zip(moves[:-1], moves[1:]):
         if t[b] - t[a + 1] >= STOP_S:
@@ -128,9 +135,7 @@ def widest_play(rec: Record) -> tuple[float, float, float] | None:
     (a real cart's log was fitted with a 68 mm play where its readings turned within 20 ms at a median turn
     and never moved faster than 0.9 m/s: 18 mm at most). On the valid readings; None where they turn fewer
     than three times."""
-    keep = rec.valid_mask
-    x, t = rec.x[keep], rec.t[keep]
-    moves = np.flatnonzero(np.diff(x) != 0.0)
+    _, x, t, moves = valid_moves(rec)
     turns = np.flatnonzero(np.diff(np.sign(np.diff(x)[moves])) != 0.0)
     if len(turns) < 3:
         return None
@@ -167,7 +172,7 @@ def contradictions(pr: Problem, model: Model, name: str) -> list[str]:
         why.append(f'cogging period {model["cogging_period_m"] * 1e3:.3g} mm: fewer than {RIPPLE_PERIODS:g} periods '
                    f'over the travel ({np.ptp(rec.x) * 1e3:.3g} mm)')
     if name == 'backlash':
-        limit = widest_play(rec)
+        limit = widest_play(rec) if model['backlash_m'] >= 2 * rec.x_resolution else None
         if model['backlash_m'] < 2 * rec.x_resolution:
             why.append(f'play {model["backlash_m"] * 1e3:.3g} mm is below two encoder counts (quantization)')
         elif limit is not None and model['backlash_m'] > limit[0]:
