@@ -172,10 +172,9 @@ def contradictions(pr: Problem, model: Model, name: str) -> list[str]:
         why.append(f'cogging period {model["cogging_period_m"] * 1e3:.3g} mm: fewer than {RIPPLE_PERIODS:g} periods '
                    f'over the travel ({np.ptp(rec.x) * 1e3:.3g} mm)')
     if name == 'backlash':
-        limit = widest_play(rec) if model['backlash_m'] >= 2 * rec.x_resolution else None
         if model['backlash_m'] < 2 * rec.x_resolution:
             why.append(f'play {model["backlash_m"] * 1e3:.3g} mm is below two encoder counts (quantization)')
-        elif limit is not None and model['backlash_m'] > limit[0]:
+        elif (limit := widest_play(rec)) is not None and model['backlash_m'] > limit[0]:
             why.append(f'play {model["backlash_m"] * 1e3:.3g} mm: the readings turn within {limit[1] * 1e3:.3g} ms '
                        f'(median of their turns) and never move faster than {limit[2]:.3g} m/s, so the encoder '
                        f'crosses {limit[0] * 1e3:.3g} mm at most')
