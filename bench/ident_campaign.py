@@ -47,8 +47,9 @@ OUTSIDE = set(campaign.OUTSIDE) | {'plant_error'}
 #: declared constants the ladder tries to correct (ipfric_core.ident.hypotheses.PLANT_CORRECTIONS)
 CORRECTED = ('M', 'alpha')
 #: a wrong declared constant that a fitted friction parameter takes over exactly: the back-EMF beta and
-#: the viscous slope eps act as one (F = alpha V - (beta + eps) x'), so the refit explains it and no
-#: answer about it is wrong
+#: the viscous slope eps act as one (F = alpha V - (beta + eps) x'), so the refit explains it (eps, or beta
+#: itself where the data want less than the declared beta: ipfric_core.ident.hypotheses.viscous_in_beta) and
+#: no answer about it is wrong, nor is its correction an answer
 EQUIVALENT = ('beta',)
 #: a wrong declared constant that two corrections take over exactly: the pendulum's mass m enters the cart's
 #: equation only (the pendulum's own, divided by m l, is free of it), so m declared k times its true value is
@@ -128,7 +129,7 @@ def predicted_answer(result: dict | None) -> dict:
     if result is None:
         return dict(label='error', added=[], verdict=None)
     added = sorted([e for e in result.get('effects_added', []) if e not in FRICTION_PARTS]
-                   + [f'{n} corrected' for n in result.get('constants_corrected', [])])
+                   + [f'{n} corrected' for n in result.get('constants_corrected', []) if n not in EQUIVALENT])
     verdict = result.get('verdict')
     if added:
         label = '+'.join(added)

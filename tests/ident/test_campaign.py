@@ -157,6 +157,8 @@ def test_a_wrong_declared_constant_expects_its_correction_or_not_explained():
     assert scorer.outcome(exp, scorer.predicted_answer(refit)) == 'missed'
     emf = _truth((('deadzone', 30.0),), {'name': 'beta', 'factor': 0.7, 'contribution_counts_rms': 900.0})
     assert scorer.expected_answer(emf, 2.0)['label'] == 'deadzone'   # eps takes a wrong beta over exactly
+    viscous = {'effects_added': ['deadzone'], 'constants_corrected': ['beta'], 'verdict': {'explained': True}}
+    assert scorer.outcome(scorer.expected_answer(emf, 2.0), scorer.predicted_answer(viscous)) == 'correct'
     as_m = {'effects_added': [], 'constants_corrected': ['M'], 'verdict': {'explained': True}}
     assert scorer.outcome(exp, scorer.predicted_answer(as_m)) == 'wrong'      # a pendulum on the cart tells them
     cart = dict(truth, pendulum_attached=False)         # the cart alone fixes M / alpha only
@@ -341,6 +343,40 @@ def test_a_drive_in_place_of_a_mass_correction_reaches_its_play_with_the_law_fre
     assert best['drive_mass_kg'] == pytest.approx(drive['motor_mass_kg'], rel=0.02)
     assert best['Fc'] == pytest.approx(truth['friction']['Fc'], rel=0.05)
     assert pe.cost(best) < 0.25 * pe.cost(corrected)
+
+
+@pytest.mark.slow
+def test_a_declared_beta_above_the_whole_viscous_term_is_corrected_with_eps_held_at_0(tmp_path):
+    """Seed 2027, case 0 (the cart alone, clean; 30 s), identified with beta declared 1.5 times its true value:
+    the data want a viscous term beta + eps (7.41 N s/m) below the declared beta (8.90), which the viscous
+    slope eps >= 0 cannot give. The refit's fit ends with eps on its bound 0; done again with eps held at 0
+    and beta fitted, beta reaches the true beta + eps and the estimation part replays to the encoders'
+    floor."""
+    from ipfric_core.analysis.records import load
+    from ipfric_core.ident import hypotheses as hy
+    from ipfric_core.ident.model import load_declared
+    from ipfric_core.ident.problem import Problem, fit_model
+    from ipfric_core.ident.refutations import bound_params
+    from ipfric_core.physics.params import PlantParams
+    campaign.generate(tmp_path, 0, 2027, indices=[0], duration=CI_DURATION)
+    d = tmp_path / campaign.case_name(0)
+    truth = json.loads((d / 'truth.json').read_text())
+    assert truth['effect_names'] == ['none'] and truth['plant_error'] is None
+    plant = PlantParams(**dict(truth['constants'], beta=1.5 * truth['constants']['beta']))
+    est, _ = load(d / 'data.csv', plant, None, True).split(0.6)
+    declared = load_declared(None, 'exponential', False, plant)
+    pe = Problem(est)
+    refit = hy.refit_of(declared)
+    short, _ = hy.short_fit(pe, declared, refit, declared, pe.screen())
+    plain = fit_model(pe, short, only=hy.joint(refit, short), prior=declared, errors=False)[0]
+    assert 'eps' in [p.name for p in bound_params(plain)]          # eps >= 0 cannot take it
+    full = hy.full_fit(pe, refit, short, declared)
+    assert full.viscous_in_beta and full['eps'] == 0.0 and not full.param('eps').free
+    viscous = truth['constants']['beta'] + truth['friction']['eps']
+    assert full['beta'] == pytest.approx(viscous, rel=0.03)
+    assert full['Fc'] == pytest.approx(truth['friction']['Fc'], rel=0.1)
+    assert pe.summary(full)['x_rms_counts'] < 0.5 * pe.summary(plain)['x_rms_counts']
+    assert not bound_params(full)
 
 
 # ------------------------------------------------------------------------------------------ slow

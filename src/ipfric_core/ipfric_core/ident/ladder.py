@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 from ..analysis.records import Record
 from .effects import PARAMS
-from .hypotheses import PLANT_CORRECTIONS, Hypothesis, errors_of, full_fit, hypotheses, refit_of, screen, short_fits
+from .hypotheses import CORRECTABLE, Hypothesis, errors_of, full_fit, hypotheses, refit_of, screen, short_fits
 from .judging import WORSE_PERCENT, Judged, beyond_refit, contribution, judge, leaner_first, verdict
 from .model import FRICTION_FITTED, LAW_PARAMS, Model
 from .problem import Problem, fit_model
@@ -103,13 +103,15 @@ def correction_notes(declared: Model, model: Model, std: dict, cart_alone: bool)
     eq. (1) times k, which is also a pendulum mass m declared k times its true value: m enters that row only
     (the pendulum's row, divided by m l, is free of it), so the note names that reading too."""
     out = []
-    for name in PLANT_CORRECTIONS:
+    for name in CORRECTABLE:
         p = model.param(name)
         if p.free:
             s = std.get(name)
             err = f' +/- {s:.2g}' if s is not None and math.isfinite(s) else ''
             out.append(f'the declared {name} is {declared[name]:.4g} {p.unit}, the data say {p.value:.4g}{err} '
-                       f'{p.unit}')
+                       f'{p.unit}' + (f' (the whole viscous term beta + eps, with eps held at {model["eps"]:.4g} '
+                                      f'{model.param("eps").unit}: the data want less viscous damping than the '
+                                      'declared beta gives, which eps >= 0 cannot take)' if name == 'beta' else ''))
     fixed = [n for n in ('M', 'alpha') if not model.param(n).free]
     if cart_alone and len(fixed) == 1:
         other, held = fixed[0], 'alpha' if fixed[0] == 'M' else 'M'
@@ -201,11 +203,13 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
                            'runner_up': _alternative(runner, pv) if runner else None})
             break
         win = ok[0]
+        before = current
         current, s = fit_model(pe, win.model, max_nfev=60, prior=declared)   # every fitted parameter together
         if unfit(pe.rec, current, s) or pv.cost(current) > pv.cost(win.model):
             current, s = win.model, win.std
         label = {'friction': 'refit', 'law': win.h.label, 'plant': win.h.label}.get(win.h.kind, f'+ {win.h.effect}')
-        step_notes = correction_notes(declared, current, s, est.theta is None) if win.h.kind == 'plant' else []
+        corrected = win.h.kind == 'plant' or (current.viscous_in_beta and not before.viscous_in_beta)
+        step_notes = correction_notes(declared, current, s, est.theta is None) if corrected else []
         step_notes += refit_notes(declared, current) if win.h.kind in ('friction', 'law', 'plant') else []
         step_notes += held_notes(win.h, current)
         if win.h.kind == 'law' and 'Fc' not in LAW_PARAMS[current.law]:
@@ -255,15 +259,17 @@ def undo_corrections(pe: Problem, pv: Problem, declared: Model, current: Model, 
     within UNDO_SIGMA standard errors of the declared value; held there and the rest refitted, it is
     undone when the validation error stays within WORSE_PERCENT (a step '<name> as declared')."""
     std = steps[-1].std
-    for name in PLANT_CORRECTIONS:
+    for name in CORRECTABLE:
         p = current.param(name)
         s = std.get(name) if isinstance(std, dict) else None
         if not p.free or declared.param(name).free or not near(p.value, declared[name], s):
             continue
         note = (f'the data no longer move {name} from its declared {declared[name]:.4g} {p.unit} (the correction '
-                f'ended at {p.value:.4g} +/- {s:.2g} {p.unit}): held there again')
-        current = take_back(pe, pv, declared, current, current.holding({name: declared[name]}), f'{name} as declared',
-                            note, steps, say)
+                f'ended at {p.value:.4g} +/- {s:.2g} {p.unit}): held there again'
+                + (', and the viscous slope eps fitted again' if name == 'beta' else ''))
+        back = current.holding({name: declared[name]})
+        back = back.with_free(('eps',)) if name == 'beta' and 'eps' in LAW_PARAMS[back.law] else back
+        current = take_back(pe, pv, declared, current, back, f'{name} as declared', note, steps, say)
     return current
 
 
@@ -288,6 +294,10 @@ def held_notes(h: Hypothesis, model: Model) -> list[str]:
     out = []
     for p in model.params:
         if p.name in h.free and p.name in LAW_PARAMS[model.law] and not p.free:
+            if p.name == 'eps' and model.viscous_in_beta:
+                out.append(f'eps held at {p.value:.4g} {p.unit}: the viscous term is beta\'s, fitted in its place '
+                           '(the two act alike)')
+                continue
             why = ('it ended on its bound, or within two standard errors of zero' if p.name == 'Fc'
                    else 'the refit put it on a bound')
             out.append(f'{p.name} held at {p.value:.4g} {p.unit}: the data do not determine it ({why})')

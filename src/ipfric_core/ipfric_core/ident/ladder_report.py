@@ -17,7 +17,7 @@ from ..analysis.records import smooth_rate  # noqa: E402
 from ..physics.friction import friction_force  # noqa: E402
 from . import shooting  # noqa: E402
 from .effects import BASE_MODELS, PARAMS, static_level  # noqa: E402
-from .hypotheses import PLANT_CORRECTIONS  # noqa: E402
+from .hypotheses import CORRECTABLE  # noqa: E402
 from .ladder import Step  # noqa: E402
 from .problem import Problem  # noqa: E402
 
@@ -180,7 +180,7 @@ def ladder_result(res: dict) -> dict:
                     'notes': s.notes + coverage_note(s, at) + curve_note(s)}
                    for s in steps],
         'effects_added': list(steps[-1].model.effects),
-        'constants_corrected': [n for n in PLANT_CORRECTIONS if steps[-1].model.param(n).free],
+        'constants_corrected': [n for n in CORRECTABLE if steps[-1].model.param(n).free],
         'verdict': res['verdict'],
         'rounds': res['rounds'],
         'effects_tried': res['tried'],

@@ -77,7 +77,11 @@ class ModelVectors:
 
 @dataclass(frozen=True)
 class Model:
-    """A declared plant and friction law plus added effects, with every parameter."""
+    """A declared plant and friction law plus added effects, with every parameter.
+
+    The back-EMF beta and the viscous slope eps act alike (F = alpha V - (beta + eps) x', paper eq. 2):
+    they are never fitted together. Where beta is fitted, eps is held (:meth:`with_free`,
+    :meth:`with_law`) and keeps its value (:meth:`with_values`): the whole viscous term is beta's."""
 
     law: str                       # viscous, coulomb, exponential or dynamic (a key of LAW_PARAMS)
     params: tuple                  # Param, in order
@@ -104,8 +108,15 @@ class Model:
         return [p for p in self.params if p.free]
 
     def with_values(self, values: dict) -> Model:
-        return replace(self, params=tuple(replace(p, value=float(values[p.name])) if p.name in values else p
-                                          for p in self.params))
+        """This model with the values of ``values`` (but a held eps beside a fitted beta: see the class)."""
+        keep = {'eps'} if self.viscous_in_beta else set()
+        return replace(self, params=tuple(replace(p, value=float(values[p.name]))
+                                          if p.name in values and p.name not in keep else p for p in self.params))
+
+    @property
+    def viscous_in_beta(self) -> bool:
+        """True where beta is fitted: the viscous slope eps is then held, the viscous term is beta's."""
+        return any(p.name == 'beta' and p.free for p in self.params)
 
     def with_effect(self, name: str, starts: dict | None = None) -> Model:
         """This model with effect ``name`` added (its parameters free, at ``starts`` or 0)."""
@@ -120,7 +131,9 @@ class Model:
         return self.with_free(names)
 
     def with_free(self, names) -> Model:
-        """This model with the parameters ``names`` fitted (the others as they are)."""
+        """This model with the parameters ``names`` fitted (the others as they are); but eps where beta is
+        fitted (see the class)."""
+        names = set(names) - ({'eps'} if self.viscous_in_beta or 'beta' in names else set())
         return replace(self, params=tuple(replace(p, free=True) if p.name in names else p for p in self.params))
 
     def holding(self, values: dict) -> Model:
@@ -134,8 +147,8 @@ class Model:
                                           for p in self.params))
 
     def fitted(self, names) -> bool:
-        """True when every parameter of ``names`` this model has is fitted."""
-        return all(p.free for p in self.params if p.name in names)
+        """True when every parameter of ``names`` this model has is fitted (eps by beta, see the class)."""
+        return all(p.free or (p.name == 'eps' and self.viscous_in_beta) for p in self.params if p.name in names)
 
     def with_law(self, law: str, starts: dict) -> Model:
         """This model with the friction law ``law`` (one of :data:`LAW_PARAMS`): its parameters fitted, at
@@ -143,7 +156,7 @@ class Model:
         own = set(LAW_PARAMS[law])
         kept = [p for p in self.params if p.name not in FRICTION_FITTED]
         new = [param(n, max(self.get(n, starts[n]) if any(p.name == n for p in self.params) else starts[n],
-                            lower_bound(n, BASE_MODELS[law])), True, law)
+                            lower_bound(n, BASE_MODELS[law])), not (n == 'eps' and self.viscous_in_beta), law)
                for n in LAW_PARAMS[law] if n in own]
         plant = [p for p in kept if p.name in PLANT_KNOWN]
         rest = [p for p in kept if p.name not in PLANT_KNOWN]
