@@ -54,6 +54,7 @@ def row(rig: str, log: str, run: dict, result: dict | None) -> dict:
         return dict(out, kept='-', verdict=f'refused: {run.get("error", "no result.json")}', friction='-', bound='-')
     kept = [r['kept'] for r in result['rounds'] if r['kept']]
     kept += [s['step'] for s in result['ladder'] if s['step'].endswith(' as declared')]
+    kept += [f'{n} corrected' for n in result.get('constants_corrected', []) if f'{n} corrected' not in kept]
     v = result['verdict']
     params = {p['name']: p for p in result['ladder'][-1]['params']}
     def level(name: str, digits: int) -> str:
