@@ -266,10 +266,10 @@ def undo_corrections(pe: Problem, pv: Problem, declared: Model, current: Model, 
             continue
         note = (f'the data no longer move {name} from its declared {declared[name]:.4g} {p.unit} (the correction '
                 f'ended at {p.value:.4g} +/- {s:.2g} {p.unit}): held there again'
-                + (', and the viscous slope eps fitted again' if name == 'beta' else ''))
-        back = current.holding({name: declared[name]})
-        back = back.with_free(('eps',)) if name == 'beta' and 'eps' in LAW_PARAMS[back.law] else back
-        current = take_back(pe, pv, declared, current, back, f'{name} as declared', note, steps, say)
+                + (f', the viscous slope eps with it at {current["eps"]:.4g} {current.param("eps").unit} (the data '
+                   'do not tell it from there)' if name == 'beta' else ''))
+        current = take_back(pe, pv, declared, current, current.holding({name: declared[name]}), f'{name} as declared',
+                            note, steps, say)
     return current
 
 
