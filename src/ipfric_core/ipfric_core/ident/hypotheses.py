@@ -91,7 +91,7 @@ class Hypothesis:
 
 def refit_of(current: Model, starts: list | None = None) -> Hypothesis:
     """The hypothesis that ``current``'s friction levels (its law's) are off: they are refitted."""
-    law = LAW_PARAMS[current.law]
+    law = current.law_fitted()
     return Hypothesis('refit', 'friction', current.with_free(law), law, law, starts or [{}])
 
 
@@ -104,7 +104,7 @@ def hypotheses(pe: Problem, current: Model, declared: Model, allowed=None, balan
     (:func:`balance_starts`). A law refitted with some of its levels held (:func:`full_fit`) counts as
     refitted, and the held ones stay held: the data did not determine them."""
     rec = pe.rec
-    law = LAW_PARAMS[current.law]
+    law = current.law_fitted()
     refitted = any(current.param(n).free for n in law)
     levels = tuple(n for n in ('Fc', 'Fs_excess') if n in law and (current.param(n).free or not refitted))
     balance = balance or {}
@@ -117,7 +117,7 @@ def hypotheses(pe: Problem, current: Model, declared: Model, allowed=None, balan
             m = current.with_law(other, law_starts(declared))
             if other == 'dynamic':      # bristles stiffer than a tenth of a count of presliding are not seen
                 m = m.with_bounds('sigma0', 0.0, 10 * peak_level(m) / rec.x_resolution)
-            out.append(Hypothesis(f'law {other}', 'law', m, LAW_PARAMS[other], LAW_PARAMS[other],
+            out.append(Hypothesis(f'law {other}', 'law', m, m.law_fitted(), m.law_fitted(),
                                   bristle_starts(m) if other == 'dynamic' else [{}] + stribeck_starts(m)))
     for name in PLANT_CORRECTIONS:
         if not current.param(name).free:
@@ -161,7 +161,7 @@ def in_place_of_mass(pe: Problem, current: Model, declared: Model) -> Hypothesis
     base = base.with_bounds('drive_mass_kg', MIN_DRIVE_SHARE * declared['M'], math.inf)
     extra = current['M'] - declared['M']
     starts = [s for gap in IN_PLACE_GAPS for s in drive_starts(pe, base, current, keep=1, masses=[extra], gaps=[gap])]
-    own, law = EFFECTS[name].params, LAW_PARAMS[current.law]
+    own, law = EFFECTS[name].params, current.law_fitted()
     return Hypothesis(f'{name} in place of M corrected', 'effect', base.with_free(law), own, own + law,
                       starts, name, screened=False)
 
@@ -220,7 +220,7 @@ def short_fits(pe: Problem, current: Model, hs: list[Hypothesis], prior: Model, 
     seed = {}
     if out:
         refit = next(iter(out.values()))[0]
-        law = LAW_PARAMS[refit.law]
+        law = refit.law_fitted()
         seed = {n: refit[n] for n in law}
     with_levels = [i for i, h in enumerate(hs) if h.kind == 'effect' and h.levels]
     for i, h in enumerate(hs):

@@ -109,9 +109,7 @@ def correction_notes(declared: Model, model: Model, std: dict, cart_alone: bool)
             s = std.get(name)
             err = f' +/- {s:.2g}' if s is not None and math.isfinite(s) else ''
             out.append(f'the declared {name} is {declared[name]:.4g} {p.unit}, the data say {p.value:.4g}{err} '
-                       f'{p.unit}' + (f' (the whole viscous term beta + eps, with eps held at {model["eps"]:.4g} '
-                                      f'{model.param("eps").unit}: the data want less viscous damping than the '
-                                      'declared beta gives, which eps >= 0 cannot take)' if name == 'beta' else ''))
+                       f'{p.unit}' + (viscous_note(declared, model) if name == 'beta' else ''))
     fixed = [n for n in ('M', 'alpha') if not model.param(n).free]
     if cart_alone and len(fixed) == 1:
         other, held = fixed[0], 'alpha' if fixed[0] == 'M' else 'M'
@@ -131,6 +129,15 @@ def correction_notes(declared: Model, model: Model, std: dict, cart_alone: bool)
                        f'{declared["m"] / k:.4g} kg instead of the declared {declared["m"]:.4g} kg (m enters the '
                        'cart\'s equation only): these data do not tell the two apart')
     return out
+
+
+def viscous_note(declared: Model, model: Model) -> str:
+    """Why beta is fitted in ``model``, and what eps is held at."""
+    eps = f'eps held at {model["eps"]:.4g} {model.param("eps").unit}'
+    if model['eps'] == 0.0 and model['beta'] < declared['beta']:
+        return (f' (the whole viscous term beta + eps, with {eps}: the data want less viscous damping than the '
+                'declared beta gives, which eps >= 0 cannot take)')
+    return f' (with {eps}: beta and eps act alike, the data fix beta + eps)'
 
 
 def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress=None) -> dict:
@@ -262,6 +269,14 @@ def undo_corrections(pe: Problem, pv: Problem, declared: Model, current: Model, 
     for name in CORRECTABLE:
         p = current.param(name)
         s = std.get(name) if isinstance(std, dict) else None
+        if name == 'beta' and p.free and not declared.param(name).free and p.value > declared[name]:
+            note = (f'the viscous term ended above the declared beta ({p.value:.4g} against {declared[name]:.4g} '
+                    f'{p.unit}): beta held as declared again, the rest the viscous slope eps\'s')
+            back = current.holding({name: declared[name]}).with_free(('eps',))
+            current = take_back(pe, pv, declared, current, back.with_values({'eps': current['eps'] + p.value
+                                                                              - declared[name]}),
+                                f'{name} as declared', note, steps, say)
+            continue
         if not p.free or declared.param(name).free or not near(p.value, declared[name], s):
             continue
         note = (f'the data no longer move {name} from its declared {declared[name]:.4g} {p.unit} (the correction '

@@ -132,9 +132,15 @@ class Model:
 
     def with_free(self, names) -> Model:
         """This model with the parameters ``names`` fitted (the others as they are); but eps where beta is
-        fitted (see the class)."""
-        names = set(names) - ({'eps'} if self.viscous_in_beta or 'beta' in names else set())
-        return replace(self, params=tuple(replace(p, free=True) if p.name in names else p for p in self.params))
+        fitted: held there, at its value (see the class)."""
+        beta = self.viscous_in_beta or 'beta' in names
+        return replace(self, params=tuple(replace(p, free=False) if beta and p.name == 'eps'
+                                          else replace(p, free=True) if p.name in names else p for p in self.params))
+
+    def law_fitted(self) -> tuple:
+        """The parameters that fit this model's friction law: its :data:`LAW_PARAMS`, with beta in place of
+        eps where the viscous term is beta's (see the class)."""
+        return tuple('beta' if n == 'eps' and self.viscous_in_beta else n for n in LAW_PARAMS[self.law])
 
     def holding(self, values: dict) -> Model:
         """This model with the parameters of ``values`` held there (not fitted)."""
