@@ -295,9 +295,10 @@ def viscous_in_beta(pe: Problem, h: Hypothesis, m: Model, prior: Model) -> Model
     true beta + eps of 11.8 and 7.4 counts. Not where beta falls to MIN_BETA_SHARE of the declared value:
     a motor driven by voltage brakes by its back-EMF, and a fit that takes that away makes up for something
     else (seed 2027's case 25, a cart whose amplifier clips: the refit sank beta to 0 and, refused for it,
-    left the clipping nothing to be judged against)."""
+    left the clipping nothing to be judged against). Nor where no back-EMF is declared (a force input, a
+    current-driven motor: beta 0)."""
     p = m.param('eps') if any(q.name == 'eps' for q in m.params) else None
-    if p is None or p not in bound_params(m) or p.value - p.lo > p.hi - p.value:
+    if p is None or prior['beta'] <= 0.0 or p not in bound_params(m) or p.value - p.lo > p.hi - p.value:
         return m
     moved = m.holding({'eps': 0.0}).with_free(('beta',)).with_bounds('beta', MIN_BETA_SHARE * prior['beta'], math.inf)
     fitted = fit_model(pe, moved, only=joint(h, m) | {'beta'}, prior=prior, errors=False)[0]
