@@ -48,7 +48,7 @@ OUTSIDE = set(campaign.OUTSIDE) | {'plant_error'}
 CORRECTED = ('M', 'alpha')
 #: a wrong declared constant that a fitted friction parameter takes over exactly: the back-EMF beta and
 #: the viscous slope eps act as one (F = alpha V - (beta + eps) x'), so the refit explains it (eps, or beta
-#: itself where the data want less than the declared beta: ipfric_core.ident.hypotheses.viscous_in_beta) and
+#: itself where the data want less than the declared beta: ipfric_core.ident.hypotheses.beta_for_eps) and
 #: no answer about it is wrong, nor is its correction an answer
 EQUIVALENT = ('beta',)
 #: a wrong declared constant that two corrections take over exactly: the pendulum's mass m enters the cart's

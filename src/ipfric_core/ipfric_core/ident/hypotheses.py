@@ -32,7 +32,7 @@ from .starts import (
 )
 
 __all__ = ['refit_of', 'LAWS', 'PLANT_CORRECTIONS', 'CORRECTABLE', 'Hypothesis', 'hypotheses', 'in_place_of_mass',
-           'short_fit', 'short_fits', 'joint', 'full_fit', 'viscous_in_beta', 'contact_held', 'errors_of', 'screen']
+           'short_fit', 'short_fits', 'joint', 'full_fit', 'beta_for_eps', 'contact_held', 'errors_of', 'screen']
 
 #: the friction laws the ladder weighs against each other
 LAWS = ('viscous', 'coulomb', 'exponential', 'dynamic')
@@ -40,7 +40,7 @@ LAWS = ('viscous', 'coulomb', 'exponential', 'dynamic')
 #: force per volt); not the back-EMF beta: it acts on the cart as the viscous slope eps does, which every law fits
 PLANT_CORRECTIONS = ('M', 'alpha')
 #: the declared constants a final model may correct: the plant corrections, and beta where the data want less
-#: viscous damping than it gives (:func:`viscous_in_beta`)
+#: viscous damping than it gives (:func:`beta_for_eps`)
 CORRECTABLE = PLANT_CORRECTIONS + ('beta',)
 SCREEN_GAIN = 0.01       # an effect whose own parameters lower the estimation cost less is not refitted
 #: effects started from a grid of their error: when its best point lowers the cart's estimation cost by
@@ -56,7 +56,7 @@ REDO_LOSS = 0.1
 
 #: the lightest motor side of a drive with play the ladder fits [share of the cart's mass]
 MIN_DRIVE_SHARE = 0.02
-#: the least back-EMF a correction of beta may find [share of the declared beta] (:func:`viscous_in_beta`)
+#: the least back-EMF a correction of beta may find [share of the declared beta] (:func:`beta_for_eps`)
 MIN_BETA_SHARE = 0.5
 
 
@@ -260,10 +260,10 @@ def full_fit(pe: Problem, h: Hypothesis, best: Model, prior: Model) -> Model:
     amplifier clipping at 2.7 V that explained a balancing loop to its floor was refused for an Fc of
     0.07 +/- 0.13 N). That test checks the Coulomb level's error alone (:func:`errors_of` ``among``): the
     others are computed for the hypotheses that pass (:func:`~ipfric_core.ident.ladder.confirm`). A fit that
-    puts the viscous slope on 0 is done again with the viscous term in beta (:func:`viscous_in_beta`)."""
+    puts the viscous slope on 0 is done again with the viscous term in beta (:func:`beta_for_eps`)."""
     def fit(m: Model, held: dict) -> Model:
         m = fit_model(pe, m.holding(held), only=joint(h, m) - set(held), prior=prior, errors=False)[0]
-        return viscous_in_beta(pe, h, m, prior)
+        return beta_for_eps(pe, h, m, prior)
     m = fit(best, {})
     contact = contact_held(m)
     if contact:
@@ -285,7 +285,7 @@ def full_fit(pe: Problem, h: Hypothesis, best: Model, prior: Model) -> Model:
     return m
 
 
-def viscous_in_beta(pe: Problem, h: Hypothesis, m: Model, prior: Model) -> Model:
+def beta_for_eps(pe: Problem, h: Hypothesis, m: Model, prior: Model) -> Model:
     """``m`` fitted again with the viscous slope eps held at 0 and the back-EMF beta fitted, where the fit
     put eps on its lower bound 0: the data want less viscous damping than the declared beta gives (F =
     alpha V - (beta + eps) x', paper eq. 2), which eps >= 0 cannot take and beta can (a motor's winding
@@ -297,8 +297,8 @@ def viscous_in_beta(pe: Problem, h: Hypothesis, m: Model, prior: Model) -> Model
     else (seed 2027's case 25, a cart whose amplifier clips: the refit sank beta to 0 and, refused for it,
     left the clipping nothing to be judged against). Nor where no back-EMF is declared (a force input, a
     current-driven motor: beta 0)."""
-    p = m.param('eps') if any(q.name == 'eps' for q in m.params) else None
-    if p is None or prior['beta'] <= 0.0 or p not in bound_params(m) or p.value - p.lo > p.hi - p.value:
+    p = next((q for q in bound_params(m) if q.name == 'eps'), None)
+    if p is None or prior['beta'] <= 0.0 or p.value - p.lo > p.hi - p.value:
         return m
     moved = m.holding({'eps': 0.0}).with_free(('beta',)).with_bounds('beta', MIN_BETA_SHARE * prior['beta'], math.inf)
     fitted = fit_model(pe, moved, only=joint(h, m) | {'beta'}, prior=prior, errors=False)[0]
