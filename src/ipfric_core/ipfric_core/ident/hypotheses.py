@@ -142,7 +142,8 @@ def hypotheses(pe: Problem, current: Model, declared: Model, allowed=None, balan
 
 
 #: the plays [m] of a drive in place of a mass correction, each a start (seed 2027's case 69, a 2.33 mm play:
-#: from 1 mm the fit ended at 1.24 mm, 4.74 counts on estimation, from 3 mm at 2.72 mm and 2.15)
+#: from 1 mm the fit ended at 1.24 mm, 4.74 counts on estimation, from 3 mm at 2.72 mm and 2.15), beside the
+#: smallest play the ladder keeps, two encoder counts (:func:`in_place_of_mass`)
 IN_PLACE_GAPS = (1e-4, 3e-4, 1e-3, 3e-3)
 
 
@@ -155,12 +156,18 @@ def in_place_of_mass(pe: Problem, current: Model, declared: Model) -> Hypothesis
     true play's neighbourhood ranks last) and fits the whole law beside its own parameters (seed 2027's
     case 77, a 1.87 mm play: the correction's fit had the viscous slope 5 % and the Stribeck velocity
     16 % off, and with them held a short fit from 1 mm ended behind one from 0.3 mm, 18.9 counts against
-    17.5; with them free, 5.3 against 12.0, and the law within 0.5 % of the truth)."""
+    17.5; with them free, 5.3 against 12.0, and the law within 0.5 % of the truth). A play of two encoder
+    counts, the smallest the ladder keeps (:func:`refutations.contradictions`), is a start too where it is
+    below IN_PLACE_GAPS' first (seed 2027's case 74, a 0.039 mm play, 2.3 counts of 0.017 mm: from 0.1 mm
+    the fit ended at 0.12 mm with 3.47 counts on validation and from 0.3 mm at 0.30 mm with 8.88, the
+    mass correction left 6.85; from 0.034 mm, at 0.045 mm with 2.82)."""
     name = 'drive_backlash'
     base = current.holding({'M': declared['M']}).with_effect(name)
     base = base.with_bounds('drive_mass_kg', MIN_DRIVE_SHARE * declared['M'], math.inf)
     extra = current['M'] - declared['M']
-    starts = [s for gap in IN_PLACE_GAPS for s in drive_starts(pe, base, current, keep=1, masses=[extra], gaps=[gap])]
+    smallest = 2 * pe.rec.x_resolution
+    gaps = ((smallest,) if smallest < IN_PLACE_GAPS[0] else ()) + IN_PLACE_GAPS
+    starts = [s for gap in gaps for s in drive_starts(pe, base, current, keep=1, masses=[extra], gaps=[gap])]
     own, law = EFFECTS[name].params, current.law_fitted()
     return Hypothesis(f'{name} in place of M corrected', 'effect', base.with_free(law), own, own + law,
                       starts, name, screened=False)
