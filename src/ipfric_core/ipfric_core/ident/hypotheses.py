@@ -31,8 +31,9 @@ from .starts import (
     stribeck_starts,
 )
 
-__all__ = ['refit_of', 'LAWS', 'PLANT_CORRECTIONS', 'CORRECTABLE', 'Hypothesis', 'hypotheses', 'in_place_of_mass',
-           'short_fit', 'short_fits', 'joint', 'full_fit', 'beta_for_eps', 'contact_held', 'errors_of', 'screen']
+__all__ = ['refit_of', 'LAWS', 'PLANT_CORRECTIONS', 'CORRECTABLE', 'Hypothesis', 'hypotheses', 'heavier_cart',
+           'in_place_of_mass', 'short_fit', 'short_fits', 'joint', 'full_fit', 'beta_for_eps', 'contact_held',
+           'errors_of', 'screen']
 
 #: the friction laws the ladder weighs against each other
 LAWS = ('viscous', 'coulomb', 'exponential', 'dynamic')
@@ -134,7 +135,7 @@ def hypotheses(pe: Problem, current: Model, declared: Model, allowed=None, balan
         if name == 'drive_backlash':   # a motor side lighter than this is no drive (and its contact rings at kHz)
             base = base.with_bounds('drive_mass_kg', MIN_DRIVE_SHARE * current['M'], math.inf)
         out.append(Hypothesis(name, 'effect', base.with_free(levels), own, own + levels, starts, name))
-        if name == 'drive_backlash' and current.param('M').free and current['M'] > declared['M']:
+        if name == 'drive_backlash' and heavier_cart(current, declared, rec.theta is None) is not None:
             out.append(in_place_of_mass(pe, current, declared))
         if not refitted:
             out.append(Hypothesis(f'{name} on the declared friction', 'effect', base, own, own, starts, name))
@@ -145,6 +146,26 @@ def hypotheses(pe: Problem, current: Model, declared: Model, allowed=None, balan
 #: from 1 mm the fit ended at 1.24 mm, 4.74 counts on estimation, from 3 mm at 2.72 mm and 2.15), beside the
 #: smallest play the ladder keeps, two encoder counts (:func:`in_place_of_mass`)
 IN_PLACE_GAPS = (1e-4, 3e-4, 1e-3, 3e-3)
+
+
+def heavier_cart(current: Model, declared: Model, cart_alone: bool) -> Model | None:
+    """``current`` as a cart heavier than declared: itself where it corrects M upwards; on the cart alone,
+    where it corrects alpha downwards, the same motion with alpha as declared and the mass, every force
+    and the viscous term divided by alpha's share of the declared value (paper eq. 2, M x'' = alpha V -
+    (beta + eps) x' - F: on the cart alone the data fix M / alpha only); else None."""
+    if current.param('M').free:
+        return current if current['M'] > declared['M'] else None
+    if not (cart_alone and current.param('alpha').free and current['alpha'] < declared['alpha']):
+        return None
+    ratio = declared['alpha'] / current['alpha']
+    scaled = {p.name: p.value * ratio for p in current.params
+              if p.unit.startswith('N') and p.name not in ('alpha', 'beta', 'eps')}
+    if current.viscous_in_beta:
+        scaled['beta'] = current['beta'] * ratio
+    else:
+        scaled['eps'] = (current['beta'] + current['eps']) * ratio - current['beta']
+    return current.holding({'alpha': declared['alpha']}).with_values({**scaled, 'M': current['M'] * ratio}) \
+        .with_free(('M',))
 
 
 def in_place_of_mass(pe: Problem, current: Model, declared: Model) -> Hypothesis:
@@ -160,8 +181,13 @@ def in_place_of_mass(pe: Problem, current: Model, declared: Model) -> Hypothesis
     counts, the smallest the ladder keeps (:func:`refutations.contradictions`), is a start too where it is
     below IN_PLACE_GAPS' first (seed 2027's case 74, a 0.039 mm play, 2.3 counts of 0.017 mm: from 0.1 mm
     the fit ended at 0.12 mm with 3.47 counts on validation and from 0.3 mm at 0.30 mm with 8.88, the
-    mass correction left 6.85; from 0.034 mm, at 0.045 mm with 2.82)."""
+    mass correction left 6.85; from 0.034 mm, at 0.045 mm with 2.82). In place of an alpha correction on
+    the cart alone too, from the same motion as a heavier cart (:func:`heavier_cart`; seed 2027's case 191,
+    a 0.046 mm play, 4.1 counts, with 0.457 kg on the motor side: alpha corrected left 7.81 counts on
+    validation, the drive in place of it reaches 0.027 mm with 0.457 kg and leaves 2.34)."""
     name = 'drive_backlash'
+    corrected = 'M' if current.param('M').free else 'alpha'
+    current = heavier_cart(current, declared, pe.rec.theta is None)
     base = current.holding({'M': declared['M']}).with_effect(name)
     base = base.with_bounds('drive_mass_kg', MIN_DRIVE_SHARE * declared['M'], math.inf)
     extra = current['M'] - declared['M']
@@ -169,7 +195,7 @@ def in_place_of_mass(pe: Problem, current: Model, declared: Model) -> Hypothesis
     gaps = ((smallest,) if smallest < IN_PLACE_GAPS[0] else ()) + IN_PLACE_GAPS
     starts = [s for gap in gaps for s in drive_starts(pe, base, current, keep=1, masses=[extra], gaps=[gap])]
     own, law = EFFECTS[name].params, current.law_fitted()
-    return Hypothesis(f'{name} in place of M corrected', 'effect', base.with_free(law), own, own + law,
+    return Hypothesis(f'{name} in place of {corrected} corrected', 'effect', base.with_free(law), own, own + law,
                       starts, name, screened=False)
 
 
