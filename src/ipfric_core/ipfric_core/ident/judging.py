@@ -68,6 +68,7 @@ class Judged:
     score: float           # validation cost with the per-parameter penalty (lower is better)
     refused: list
     std: dict = field(default_factory=dict)   # its standard errors, once it passes (ladder.confirm)
+    notes: list = field(default_factory=list)  # what its checks found that the report says where it is kept
 
 
 def judge(pe: Problem, pv: Problem, current: Model, h: Hypothesis, m: Model, note: str | None, sse0_v

@@ -1,0 +1,69 @@
+"""A drive's play whose standard error puts it within two of zero, decided by its profile (ident/ladder.py:
+closed_play): the drive fitted again with its play closed must replay the validation data worse by the rule an
+effect must pass. On records of independent code (tests/independent): a drive whose play is there, and a clean
+cart given a drive it does not have."""
+import json
+
+import pytest
+from independent import campaign, rigsim
+
+from ipfric_core.analysis.records import load
+from ipfric_core.ident.effects import EFFECTS
+from ipfric_core.ident.hypotheses import Hypothesis
+from ipfric_core.ident.judging import Judged
+from ipfric_core.ident.ladder import closed_play
+from ipfric_core.ident.model import LAW_PARAMS, load_declared
+from ipfric_core.ident.problem import Problem
+from ipfric_core.physics.params import PlantParams
+
+OWN = EFFECTS['drive_backlash'].params
+LAW = LAW_PARAMS['exponential']
+
+
+def judged(model):
+    h = Hypothesis('drive_backlash in place of M corrected', 'effect', model, OWN, OWN + LAW, effect='drive_backlash')
+    return Judged(h, model, 0.0, 0.0, 0.0, [])
+
+
+def drive(declared, gap, mass, freq, zeta, law):
+    reduced = mass * declared['M'] / (mass + declared['M'])
+    k = reduced * (2 * 3.141592653589793 * freq) ** 2
+    return declared.with_effect('drive_backlash').with_values(
+        {'drive_backlash_m': gap, 'drive_mass_kg': mass, 'drive_stiffness_N_per_m': k,
+         'drive_damping_Ns_per_m': 2 * zeta * (k * reduced) ** 0.5, **law}).with_free(OWN + LAW)
+
+
+@pytest.mark.slow
+def test_a_play_of_four_counts_is_told_from_zero_by_its_profile(tmp_path):
+    """Seed 2027, case 191: the cart alone, a 0.046 mm play (4.1 counts of 0.011 mm) with 0.457 kg on the
+    motor side, its contact at 183 Hz. The drive at the generator's values: closed, the play's absence
+    costs more than the rule allows on validation, and the closed drive leaves far more than the true one."""
+    campaign.generate(tmp_path, 0, 2027, indices=[191])
+    d = tmp_path / campaign.case_name(191)
+    truth = json.loads((d / 'truth.json').read_text())
+    e, f = truth['effects']['drive_backlash'], truth['friction']
+    est, val = load(d / 'data.csv', PlantParams(**truth['constants']), None, True).split(0.6)
+    declared = load_declared(None, 'exponential', False, PlantParams(**truth['constants']))
+    model = drive(declared, e['gap_m'], e['motor_mass_kg'], e['contact_frequency_Hz'], e['damping_ratio'],
+                  {n: f[n] for n in LAW})
+    pv = Problem(val)
+    dropped, left = closed_play(Problem(est), pv, judged(model), declared)
+    assert dropped == []
+    assert left > 1.5 * pv.summary(model)['x_rms_counts']
+
+
+def test_a_play_the_data_do_not_have_is_not_told_from_zero(tmp_path):
+    """A clean cart of the independent simulator (30 s) given a drive: 0.1 kg of its mass on a motor side
+    behind a play of two encoder counts, a stiff contact. Closed, the play changes nothing the validation
+    rule can see: the reason names it."""
+    rec = load(rigsim.write_case('cart_none', tmp_path, duration=30.0), None, cart_alone=True)
+    est, val = rec.split(0.6)
+    declared = load_declared(None, 'exponential', False)
+    truth = rigsim.RIGS['quanser']
+    fn = truth['M'] * truth['g']
+    law = {'Fc': truth['mu_c'] * fn, 'Fs_excess': (truth['mu_s'] - truth['mu_c']) * fn, 'eps': truth['eps'],
+           'v_s': truth['v_s']}
+    model = drive(declared.with_values({'M': declared['M'] - 0.1}), 2 * rec.x_resolution, 0.1, 200.0, 0.15, law)
+    dropped, left = closed_play(Problem(est), Problem(val), judged(model), declared)
+    assert len(dropped) == 1 and 'validation error drops by' in dropped[0]
+    assert left < 1.1 * Problem(val).summary(model)['x_rms_counts']
