@@ -4,6 +4,7 @@ effect must pass. On records of independent code (tests/independent): a drive wh
 cart given a drive it does not have."""
 import json
 
+import numpy as np
 import pytest
 from independent import campaign, rigsim
 
@@ -11,9 +12,9 @@ from ipfric_core.analysis.records import load
 from ipfric_core.ident.effects import EFFECTS
 from ipfric_core.ident.hypotheses import Hypothesis
 from ipfric_core.ident.judging import Judged
-from ipfric_core.ident.ladder import closed_play
+from ipfric_core.ident.ladder import closed_play, profiled
 from ipfric_core.ident.model import LAW_PARAMS, load_declared
-from ipfric_core.ident.problem import Problem
+from ipfric_core.ident.problem import Errors, Problem
 from ipfric_core.physics.params import PlantParams
 
 OWN = EFFECTS['drive_backlash'].params
@@ -67,3 +68,15 @@ def test_a_play_the_data_do_not_have_is_not_told_from_zero(tmp_path):
     dropped, left = closed_play(Problem(est), Problem(val), judged(model), declared)
     assert len(dropped) == 1 and 'validation error drops by' in dropped[0]
     assert left < 1.1 * Problem(val).summary(model)['x_rms_counts']
+
+
+@pytest.mark.parametrize('mass, se, reach, decided', [
+    (0.457, 0.00014, {}, True),                            # case 191: the motor side fixed, the play's scan confined
+    (6.0, 6.0, {}, False),                                 # the ENME303 PD log: a motor side the data do not fix
+    (0.457, 0.00014, {'drive_backlash_m': 'lo'}, False),   # the play's scan stayed low down to its bound
+])
+def test_only_a_drive_whose_motor_side_the_data_fix_has_its_play_decided_by_its_profile(mass, se, reach, decided):
+    declared = load_declared(None, 'exponential', False)
+    model = drive(declared, 2.4e-5, mass, 183.0, 0.26, {})
+    std = Errors(['drive_backlash_m', 'drive_mass_kg'], np.diag([2e-5, se]) ** 2, reach)
+    assert profiled(model, std) is decided
