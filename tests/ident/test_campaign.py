@@ -313,6 +313,23 @@ def test_an_effect_with_the_law_free_starts_from_its_fit_on_the_declared_frictio
     assert pv.cost(full) ** 0.5 < 1.0                  # counts: the encoders' floor is 0.48
 
 
+def mass_corrected_drive(tmp_path, index):
+    """Seed 2027's case ``index`` (a drive with play): its truth, its drive's truth, the estimation and
+    validation parts, the declared model and the mass correction fitted on the estimation part with the law."""
+    from ipfric_core.analysis.records import load
+    from ipfric_core.ident.model import LAW_PARAMS, load_declared
+    from ipfric_core.ident.problem import Problem, fit_model
+    from ipfric_core.physics.params import PlantParams
+    campaign.generate(tmp_path, 0, 2027, indices=[index])
+    d = tmp_path / campaign.case_name(index)
+    truth = json.loads((d / 'truth.json').read_text())
+    plant = PlantParams(**truth['constants'])
+    est, val = load(d / 'data.csv', plant, None, not truth['pendulum_attached']).split(0.6)
+    declared = load_declared(None, 'exponential', est.theta is not None, plant)
+    corrected, _ = fit_model(Problem(est), declared.with_free(('M',) + LAW_PARAMS[declared.law]), prior=declared,
+                             errors=False)
+    return truth, truth['effects']['drive_backlash'], est, val, declared, corrected
+
 @pytest.mark.slow
 def test_a_drive_in_place_of_a_mass_correction_reaches_its_play_with_the_law_free(tmp_path):
     """Seed 2027, case 77: the pendulum hanging, a drive with a 1.87 mm play and 0.566 kg on its motor side.
@@ -321,20 +338,10 @@ def test_a_drive_in_place_of_a_mass_correction_reaches_its_play_with_the_law_fre
     at 0.28-0.34 mm (the ladder then kept the correction); started from each of its plays and fitted with the
     whole law, from 1 mm it reaches about 1 mm with the motor side's mass and the Coulomb level within 1 % of
     the truth, and replays the estimation part 3.6 times closer than the correction."""
-    from ipfric_core.analysis.records import load
     from ipfric_core.ident import hypotheses as hy
-    from ipfric_core.ident.model import LAW_PARAMS, load_declared
-    from ipfric_core.ident.problem import Problem, fit_model
-    from ipfric_core.physics.params import PlantParams
-    campaign.generate(tmp_path, 0, 2027, indices=[77])
-    d = tmp_path / campaign.case_name(77)
-    truth = json.loads((d / 'truth.json').read_text())
-    drive = truth['effects']['drive_backlash']
-    plant = PlantParams(**truth['constants'])
-    est, _ = load(d / 'data.csv', plant, None, not truth['pendulum_attached']).split(0.6)
-    declared = load_declared(None, 'exponential', est.theta is not None, plant)
+    from ipfric_core.ident.problem import Problem
+    truth, drive, est, _, declared, corrected = mass_corrected_drive(tmp_path, 77)
     pe = Problem(est)
-    corrected, _ = fit_model(pe, declared.with_free(('M',) + LAW_PARAMS[declared.law]), prior=declared, errors=False)
     assert corrected['M'] - declared['M'] == pytest.approx(drive['motor_mass_kg'], rel=0.02)
     h = hy.in_place_of_mass(pe, corrected, declared)
     assert sorted(s['drive_backlash_m'] for s in h.starts) == sorted({2 * est.x_resolution, *hy.IN_PLACE_GAPS})
@@ -352,20 +359,10 @@ def test_a_drive_whose_play_is_a_few_counts_is_reached_from_the_smallest_play_th
     0.17 kg on its motor side, its contact at 61 Hz. The mass correction takes the motor side (6.85 counts
     left on validation; the true model leaves 0.94). Started from IN_PLACE_GAPS alone, the drive in place
     of it ended at 0.30 mm (8.88 counts) and the correction was kept; from two counts, it reaches the play."""
-    from ipfric_core.analysis.records import load
     from ipfric_core.ident import hypotheses as hy
-    from ipfric_core.ident.model import LAW_PARAMS, load_declared
-    from ipfric_core.ident.problem import Problem, fit_model
-    from ipfric_core.physics.params import PlantParams
-    campaign.generate(tmp_path, 0, 2027, indices=[74])
-    d = tmp_path / campaign.case_name(74)
-    truth = json.loads((d / 'truth.json').read_text())
-    drive = truth['effects']['drive_backlash']
-    plant = PlantParams(**truth['constants'])
-    est, val = load(d / 'data.csv', plant, None, not truth['pendulum_attached']).split(0.6)
-    declared = load_declared(None, 'exponential', est.theta is not None, plant)
+    from ipfric_core.ident.problem import Problem
+    _, drive, est, val, declared, corrected = mass_corrected_drive(tmp_path, 74)
     pe, pv = Problem(est), Problem(val)
-    corrected, _ = fit_model(pe, declared.with_free(('M',) + LAW_PARAMS[declared.law]), prior=declared, errors=False)
     assert corrected['M'] - declared['M'] == pytest.approx(drive['motor_mass_kg'], rel=0.02)
     h = hy.in_place_of_mass(pe, corrected, declared)
     assert min(s['drive_backlash_m'] for s in h.starts) == 2 * est.x_resolution < hy.IN_PLACE_GAPS[0]
