@@ -109,6 +109,7 @@ def hypotheses(pe: Problem, current: Model, declared: Model, allowed=None, balan
     refitted = any(current.param(n).free for n in law)
     levels = tuple(n for n in ('Fc', 'Fs_excess') if n in law and (current.param(n).free or not refitted))
     balance = balance or {}
+    heavier = heavier_cart(current, declared, rec.theta is None)
     out = []
     if not refitted:
         out.append(refit_of(current, [{}] + stribeck_starts(current)
@@ -135,8 +136,8 @@ def hypotheses(pe: Problem, current: Model, declared: Model, allowed=None, balan
         if name == 'drive_backlash':   # a motor side lighter than this is no drive (and its contact rings at kHz)
             base = base.with_bounds('drive_mass_kg', MIN_DRIVE_SHARE * current['M'], math.inf)
         out.append(Hypothesis(name, 'effect', base.with_free(levels), own, own + levels, starts, name))
-        if name == 'drive_backlash' and heavier_cart(current, declared, rec.theta is None) is not None:
-            out.append(in_place_of_mass(pe, current, declared))
+        if name == 'drive_backlash' and heavier is not None:
+            out.append(in_place_of_mass(pe, heavier, declared, 'M' if current.param('M').free else 'alpha'))
         if not refitted:
             out.append(Hypothesis(f'{name} on the declared friction', 'effect', base, own, own, starts, name))
     return out
@@ -168,7 +169,7 @@ def heavier_cart(current: Model, declared: Model, cart_alone: bool) -> Model | N
         .with_free(('M',))
 
 
-def in_place_of_mass(pe: Problem, current: Model, declared: Model) -> Hypothesis:
+def in_place_of_mass(pe: Problem, current: Model, declared: Model, corrected: str = 'M') -> Hypothesis:
     """A drive with play in place of a mass correction: the cart's mass as declared again, the mass the
     correction added on the drive's motor side (a rotor and gears reflected to the rack move with the
     cart while the play is closed: a heavier cart, until the drive reverses), the friction as fitted
@@ -181,13 +182,12 @@ def in_place_of_mass(pe: Problem, current: Model, declared: Model) -> Hypothesis
     counts, the smallest the ladder keeps (:func:`refutations.contradictions`), is a start too where it is
     below IN_PLACE_GAPS' first (seed 2027's case 74, a 0.039 mm play, 2.3 counts of 0.017 mm: from 0.1 mm
     the fit ended at 0.12 mm with 3.47 counts on validation and from 0.3 mm at 0.30 mm with 8.88, the
-    mass correction left 6.85; from 0.034 mm, at 0.045 mm with 2.82). In place of an alpha correction on
-    the cart alone too, from the same motion as a heavier cart (:func:`heavier_cart`; seed 2027's case 191,
+    mass correction left 6.85; from 0.034 mm, at 0.045 mm with 2.82). ``current`` is the heavier cart of the
+    model whose correction ``corrected`` the drive takes the place of: an alpha correction on the cart alone
+    too, from the same motion as a heavier cart (:func:`heavier_cart`; seed 2027's case 191,
     a 0.046 mm play, 4.1 counts, with 0.457 kg on the motor side: alpha corrected left 7.81 counts on
     validation, the drive in place of it reaches 0.027 mm with 0.457 kg and leaves 2.34)."""
     name = 'drive_backlash'
-    corrected = 'M' if current.param('M').free else 'alpha'
-    current = heavier_cart(current, declared, pe.rec.theta is None)
     base = current.holding({'M': declared['M']}).with_effect(name)
     base = base.with_bounds('drive_mass_kg', MIN_DRIVE_SHARE * declared['M'], math.inf)
     extra = current['M'] - declared['M']

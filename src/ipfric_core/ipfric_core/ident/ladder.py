@@ -50,16 +50,16 @@ def confirm(pe: Problem, pv: Problem, current: Model, j: Judged, prior: Model) -
     contribution to the simulated motion; the reasons it fails them are added to ``j.refused``. True where
     the one reason is a plant correction not told from the value it corrects (:func:`as_refit`)."""
     j.std = errors_of(pe, j.h, j.model, prior)
-    size = unresolved(j.model, j.std, j.h.effect) if j.h.effect else []
-    if size and j.h.effect == 'drive_backlash' and profiled(j.model, j.std):
+    untold_size = unresolved(j.model, j.std, j.h.effect) if j.h.effect else []
+    if untold_size and j.h.effect == 'drive_backlash' and profiled(j.model, j.std):
         dropped, left = closed_play(pe, pv, j, prior)
-        size = [f'{size[0]}; beyond the drive with its play closed: {dropped[0]}'] if dropped else []
-        if not size:
+        untold_size = [f'{untold_size[0]}; beyond the drive with its play closed: {dropped[0]}'] if dropped else []
+        if not untold_size:
             j.notes.append(f'drive_backlash_m = {j.model["drive_backlash_m"] * 1e3:.3g} +/- '
                            f'{j.std["drive_backlash_m"] * 1e3:.2g} mm is within two standard errors of zero; its '
                            'profile tells it from zero: the drive with its play closed leaves '
                            f'{left:.3g} counts on validation, against {pv.summary(j.model)["x_rms_counts"]:.3g}')
-    why = untold(j.model, j.std) + size
+    why = untold(j.model, j.std) + untold_size
     corrected = uncorrected(j.model, j.std, current, j.h.own) if j.h.kind == 'plant' else []
     why += corrected
     if not why:
