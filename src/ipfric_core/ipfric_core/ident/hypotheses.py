@@ -186,7 +186,7 @@ def in_place_of_mass(pe: Problem, current: Model, declared: Model, corrected: st
     model whose correction ``corrected`` the drive takes the place of: an alpha correction on the cart alone
     too, from the same motion as a heavier cart (:func:`heavier_cart`; seed 2027's case 191,
     a 0.046 mm play, 4.1 counts, with 0.457 kg on the motor side: alpha corrected left 7.81 counts on
-    validation, the drive in place of it reaches 0.027 mm with 0.457 kg and leaves 2.34)."""
+    validation, the drive in place of it reaches 0.024 mm with 0.457 kg and leaves 2.46)."""
     name = 'drive_backlash'
     base = current.holding({'M': declared['M']}).with_effect(name)
     base = base.with_bounds('drive_mass_kg', MIN_DRIVE_SHARE * declared['M'], math.inf)
