@@ -20,7 +20,7 @@ import numpy as np
 from .effects import EFFECTS
 from .model import LADDER_EFFECTS, LAW_PARAMS, Model
 from .problem import SCREEN_NFEV, Problem, fit_model
-from .refutations import SIZE, bound_params, contradictions, untold
+from .refutations import SIZE, bound_params, contradictions, smallest_play, untold
 from .starts import (
     bristle_starts,
     contact_damping,
@@ -179,7 +179,7 @@ def in_place_of_mass(pe: Problem, current: Model, declared: Model, corrected: st
     case 77, a 1.87 mm play: the correction's fit had the viscous slope 5 % and the Stribeck velocity
     16 % off, and with them held a short fit from 1 mm ended behind one from 0.3 mm, 18.9 counts against
     17.5; with them free, 5.3 against 12.0, and the law within 0.5 % of the truth). A play of two encoder
-    counts, the smallest the ladder keeps (:func:`refutations.contradictions`), is a start too where it is
+    counts, the smallest the ladder keeps (:func:`refutations.smallest_play`), is a start too where it is
     below IN_PLACE_GAPS' first (seed 2027's case 74, a 0.039 mm play, 2.3 counts of 0.017 mm: from 0.1 mm
     the fit ended at 0.12 mm with 3.47 counts on validation and from 0.3 mm at 0.30 mm with 8.88, the
     mass correction left 6.85; from 0.034 mm, at 0.045 mm with 2.82). ``current`` is the heavier cart of the
@@ -191,7 +191,7 @@ def in_place_of_mass(pe: Problem, current: Model, declared: Model, corrected: st
     base = current.holding({'M': declared['M']}).with_effect(name)
     base = base.with_bounds('drive_mass_kg', MIN_DRIVE_SHARE * declared['M'], math.inf)
     extra = current['M'] - declared['M']
-    smallest = 2 * pe.rec.x_resolution
+    smallest = smallest_play(pe.rec)
     gaps = ((smallest,) if smallest < IN_PLACE_GAPS[0] else ()) + IN_PLACE_GAPS
     starts = [s for gap in gaps for s in drive_starts(pe, base, current, keep=1, masses=[extra], gaps=[gap])]
     own, law = EFFECTS[name].params, current.law_fitted()

@@ -45,28 +45,15 @@ CLOSED_PLAY = 1e-9       # a drive's play closed [m]: a compliant contact withou
 
 def confirm(pe: Problem, pv: Problem, current: Model, j: Judged, prior: Model) -> bool:
     """The checks of a hypothesis that passed :func:`judge` which need its standard errors (its size told
-    from zero, a drive's play by its profile where they do not: :func:`profiled`; a plant correction
+    from zero, a drive's play against its closed play: :func:`play_checks`; a plant correction
     told from the value it corrects, a Coulomb level told from zero) and its
     contribution to the simulated motion; the reasons it fails them are added to ``j.refused``. True where
     the one reason is a plant correction not told from the value it corrects (:func:`as_refit`)."""
     j.std = errors_of(pe, j.h, j.model, prior)
-    untold_size = unresolved(j.model, j.std, j.h.effect) if j.h.effect else []
-    if j.h.effect == 'drive_backlash' and (not untold_size or profiled(j.model, j.std)):
-        dropped, left, better = closed_play(pe, pv, j, prior)
-        here = pv.summary(j.model)['x_rms_counts']
-        if better:
-            untold_size = [f'the drive with its play closed (a compliant contact without play) replays the validation '
-                           f'data better, {left:.3g} counts against {here:.3g}: the play is a local minimum of the '
-                           'fit, the data show none']
-        elif untold_size and dropped:
-            untold_size = [f'{untold_size[0]}; beyond the drive with its play closed: {dropped[0]}']
-        elif untold_size:
-            untold_size = []
-            j.notes.append(f'drive_backlash_m = {j.model["drive_backlash_m"] * 1e3:.3g} +/- '
-                           f'{j.std["drive_backlash_m"] * 1e3:.2g} mm is within two standard errors of zero; its '
-                           f'profile tells it from zero: the drive with its play closed leaves {left:.3g} counts '
-                           f'on validation, against {here:.3g}')
-    why = untold(j.model, j.std) + untold_size
+    unsized = unresolved(j.model, j.std, j.h.effect) if j.h.effect else []
+    if j.h.effect == 'drive_backlash':
+        unsized = play_checks(pe, pv, j, prior, unsized)
+    why = untold(j.model, j.std) + unsized
     corrected = uncorrected(j.model, j.std, current, j.h.own) if j.h.kind == 'plant' else []
     why += corrected
     if not why:
@@ -76,6 +63,30 @@ def confirm(pe: Problem, pv: Problem, current: Model, j: Judged, prior: Model) -
                        f'too small to matter at the encoders)')
     j.refused += why
     return bool(corrected) and why == corrected
+
+
+def play_checks(pe: Problem, pv: Problem, j: Judged, prior: Model, size: list[str]) -> list[str]:
+    """A drive's play judged against the drive with its play closed (:func:`closed_play`), where its size
+    told from zero or not (``size``: :func:`unresolved`'s reasons) may be decided so (:func:`profiled`):
+    refused where the closed one replays the validation data better (the play a local minimum of the fit);
+    a play within two standard errors of zero told from zero by that profile (the report says so in
+    ``j.notes``) or, where it is not, refused with both reasons. Returns the reasons about its size."""
+    if size and not profiled(j.model, j.std):
+        return size
+    dropped, left, better = closed_play(pe, pv, j, prior)
+    here = pv.summary(j.model)['x_rms_counts']
+    if better:
+        return [f'the drive with its play closed (a compliant contact without play) replays the validation data '
+                f'better, {left:.3g} counts against {here:.3g}: the play is a local minimum of the fit, the data show '
+                'none']
+    if size and dropped:
+        return [f'{size[0]}; beyond the drive with its play closed: {dropped[0]}']
+    if size:
+        j.notes.append(f'drive_backlash_m = {j.model["drive_backlash_m"] * 1e3:.3g} +/- '
+                       f'{j.std["drive_backlash_m"] * 1e3:.2g} mm is within two standard errors of zero; its profile '
+                       f'tells it from zero: the drive with its play closed leaves {left:.3g} counts on validation, '
+                       f'against {here:.3g}')
+    return []
 
 
 def profiled(model: Model, std: dict) -> bool:

@@ -21,8 +21,9 @@ __all__ = ['SIZE', 'RIPPLE_PERIODS', 'valid_moves', 'stops_and_starts', 'smalles
            'response_lag',
            'crossings', 'unseen', 'drive_crossings', 'widest_play',
            'contradictions', 'unresolved', 'near', 'uncorrected', 'rest_offset', 'no_static_level', 'bound_params',
-           'on_bounds', 'untold', 'reversals', 'never_starts', 'unfit']
+           'on_bounds', 'untold', 'reversals', 'never_starts', 'unfit', 'smallest_play']
 
+PLAY_COUNTS = 2.0        # a play (the encoder's or a drive's) below this many encoder counts is quantization
 UNDO_SIGMA = 2.0         # a correction that ends this many standard errors from the declared value or closer is undone
 STOP_S = 0.05            # a stretch this long with the encoder still is a stop [s]
 BREAKAWAY_S = 0.5        # a cart that starts from rest travels three counts within this long [s]
@@ -145,6 +146,11 @@ def widest_play(rec: Record) -> tuple[float, float, float] | None:
     return fastest * turn + 2 * rec.x_resolution, turn, fastest
 
 
+def smallest_play(rec: Record) -> float:
+    """The smallest play [m] the ladder keeps: PLAY_COUNTS encoder counts (below, the readings' rounding)."""
+    return PLAY_COUNTS * rec.x_resolution
+
+
 def contradictions(pr: Problem, model: Model, name: str) -> list[str]:
     """Why the data refute the fitted effect ``name`` (empty when nothing does)."""
     rec = pr.rec
@@ -172,14 +178,14 @@ def contradictions(pr: Problem, model: Model, name: str) -> list[str]:
         why.append(f'cogging period {model["cogging_period_m"] * 1e3:.3g} mm: fewer than {RIPPLE_PERIODS:g} periods '
                    f'over the travel ({np.ptp(rec.x) * 1e3:.3g} mm)')
     if name == 'backlash':
-        if model['backlash_m'] < 2 * rec.x_resolution:
+        if model['backlash_m'] < smallest_play(rec):
             why.append(f'play {model["backlash_m"] * 1e3:.3g} mm is below two encoder counts (quantization)')
         elif (limit := widest_play(rec)) is not None and model['backlash_m'] > limit[0]:
             why.append(f'play {model["backlash_m"] * 1e3:.3g} mm: the readings turn within {limit[1] * 1e3:.3g} ms '
                        f'(median of their turns) and never move faster than {limit[2]:.3g} m/s, so the encoder '
                        f'crosses {limit[0] * 1e3:.3g} mm at most')
     if name == 'drive_backlash':
-        if model['drive_backlash_m'] < 2 * rec.x_resolution:
+        if model['drive_backlash_m'] < smallest_play(rec):
             why.append(f'drive play {model["drive_backlash_m"] * 1e3:.3g} mm is below two encoder counts '
                        f'(quantization)')
         samples, seconds = drive_crossings(pr, model)
