@@ -64,6 +64,9 @@ THRESHOLD = 2.0          # counts RMS: an effect's contribution from which it mu
 #: drive play under two counts): a smaller one, whatever its contact's ringing does, is scored as the cart
 #: heavier by the motor side
 MIN_PLAY_COUNTS = 2.0
+#: the answer of a drive whose play the final model holds closed (a compliant contact without play): the two-mass
+#: drive of a play the encoder shows no play of, named with its ringing; a drive whose play it does show, missed
+CLOSED_DRIVE = 'drive_backlash (play closed)'
 BINS = (0.0, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 1000.0, math.inf)
 TIMEOUT = 1800.0
 
@@ -96,7 +99,7 @@ def components(truth: dict, threshold: float = THRESHOLD) -> list[dict]:
             why = (f'a play of {play:.2g} encoder counts (the encoder shows no play under {MIN_PLAY_COUNTS:g})'
                    if play < MIN_PLAY_COUNTS else f'a drive play of {part:.2g} counts')
             comp.update(name='M corrected', detail=f'{why}: the motor side ({v["motor_mass_kg"]:.3g} kg) moves '
-                        'with the cart')
+                        'with the cart', alike=[CLOSED_DRIVE] if play < MIN_PLAY_COUNTS else [])
         elif part is not None:
             comp.update(counts=min(comp['counts'], float(part)),
                         detail=f'{comp["counts"]:.3g} counts, {part:.3g} of them beyond {nearer}')
@@ -120,7 +123,9 @@ def expected_answer(truth: dict, threshold: float = THRESHOLD) -> dict:
     label = '+'.join(above) if above else ('not_explained' if outside else 'none')
     # the corrections that are the same model as the only discrepancy, a wrong constant (:data:`SCALED`)
     same = [c.get('same_as', []) for c in seen if not c['library'] and c['counts'] >= threshold]
-    return dict(label=label, library=above, outside=outside, below=below,
+    # the other names of a library answer (a drive below the encoder's play: its play closed)
+    alike = {n: c['name'] for c in seen if c['library'] and c['counts'] >= threshold for n in c.get('alike', ())}
+    return dict(label=label, library=above, outside=outside, below=below, alike=alike,
                 same_as=same[0] if not above and len(same) == 1 else [],
                 clean=not comps, pendulum=truth.get('pendulum_attached', True))
 
@@ -128,7 +133,11 @@ def expected_answer(truth: dict, threshold: float = THRESHOLD) -> dict:
 def predicted_answer(result: dict | None) -> dict:
     if result is None:
         return dict(label='error', added=[], verdict=None)
-    added = sorted([e for e in result.get('effects_added', []) if e not in FRICTION_PARTS]
+    final = {p['name']: p for p in (result.get('ladder') or [{}])[-1].get('params', [])}
+    play = final.get('drive_backlash_m')
+    closed = play is not None and not play['fitted'] and play['value'] <= 1e-9
+    added = sorted([CLOSED_DRIVE if e == 'drive_backlash' and closed else e
+                    for e in result.get('effects_added', []) if e not in FRICTION_PARTS]
                    + [f'{n} corrected' for n in result.get('constants_corrected', []) if n not in EQUIVALENT])
     verdict = result.get('verdict')
     if added:
@@ -164,7 +173,8 @@ def _kind(name: str, pendulum: bool = True) -> str:
 
 
 def outcome(expected: dict, predicted: dict) -> str:
-    """correct | alike (an effect that acts alike named: :data:`ALIKE`; or, for a wrong constant, the
+    """correct | alike (an effect that acts alike named: :data:`ALIKE`; a drive below the encoder's play
+    named with its play closed, :data:`CLOSED_DRIVE`; or, for a wrong constant, the
     corrections that are the same model: :data:`SCALED`) | acceptable (below threshold) | partial |
     false_positive | missed | wrong | error."""
     e, p = expected['label'], predicted['label']
@@ -172,8 +182,9 @@ def outcome(expected: dict, predicted: dict) -> str:
         return 'error'
     if p == e:
         return 'correct'
+    named = [expected.get('alike', {}).get(n, n) for n in predicted['added']]
     if expected['library'] and predicted['added'] and \
-            sorted(_kind(n, expected['pendulum']) for n in predicted['added']) == \
+            sorted(_kind(n, expected['pendulum']) for n in named) == \
             sorted(_kind(n, expected['pendulum']) for n in expected['library']):
         return 'alike'
     if e == 'none':

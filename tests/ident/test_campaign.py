@@ -198,8 +198,15 @@ def test_a_drive_whose_play_is_not_seen_expects_the_mass_of_its_motor_side():
     tiny.update(encoder={'x_count_m': 2.5e-5})
     tiny['effects']['drive_backlash']['gap_m'] = 1e-5
     assert scorer.expected_answer(tiny, 2.0)['label'] == 'M corrected'   # as the ladder refutes it
+    # named with its play closed (a compliant contact without play), the drive itself: alike
+    closed = dict(play, ladder=[{'params': [{'name': 'drive_backlash_m', 'value': 1e-9, 'fitted': False}]}])
+    assert scorer.predicted_answer(closed)['added'] == [scorer.CLOSED_DRIVE]
+    assert scorer.outcome(scorer.expected_answer(tiny, 2.0), scorer.predicted_answer(closed)) == 'alike'
+    assert scorer.outcome(scorer.expected_answer(tiny, 2.0), scorer.predicted_answer(play)) == 'wrong'
     tiny['effects']['drive_backlash']['gap_m'] = 7.5e-5                   # three counts: a play to name
     assert scorer.expected_answer(tiny, 2.0)['label'] == 'drive_backlash'
+    assert scorer.outcome(scorer.expected_answer(tiny, 2.0), scorer.predicted_answer(closed)) == 'wrong'
+    assert scorer.outcome(hidden, scorer.predicted_answer(closed)) == 'wrong'   # its play unseen for its size only
 
 
 def test_standard_errors_are_checked_against_the_truth_on_clean_cases():
@@ -371,6 +378,33 @@ def test_a_drive_whose_play_is_a_few_counts_is_reached_from_the_smallest_play_th
     assert full['drive_backlash_m'] == pytest.approx(drive['gap_m'], rel=0.4)
     assert full['drive_mass_kg'] == pytest.approx(drive['motor_mass_kg'], rel=0.02)
     assert pv.cost(full) < 0.25 * pv.cost(corrected)
+
+@pytest.mark.slow
+def test_a_motor_side_behind_a_play_below_the_encoders_rings_through_a_contact_with_its_play_closed(tmp_path):
+    """Seed 2027, case 106: the cart alone at 2 ms, 0.569 kg on a motor side behind a play of 0.25 encoder
+    counts (a contact at 134 Hz). A mass correction takes the motor side and leaves its ringing (the ladder's
+    left 13.3 counts on validation); the drive with its play closed (a compliant contact without play),
+    fitted as the ladder's first round fits it (from the refit's short fit, the law free), reaches the motor
+    side and the friction within 1 %, and the data contradict nothing of it (a play under two counts they
+    would)."""
+    from ipfric_core.ident import hypotheses as hy
+    from ipfric_core.ident.problem import Problem
+    from ipfric_core.ident.refutations import CLOSED_PLAY, contradictions, play_closed
+    truth, drive, est, val, declared, _ = mass_corrected_drive(tmp_path, 106)
+    pe, pv = Problem(est), Problem(val)
+    assert drive['gap_m'] < 0.5 * est.x_resolution
+    hs = hy.hypotheses(pe, declared, declared)
+    h = next(h for h in hs if h.label == 'drive_backlash with its play closed')
+    assert 'drive_backlash_m' not in h.free and all(s['drive_backlash_m'] == CLOSED_PLAY for s in h.starts)
+    refit = next(h for h in hs if h.kind == 'friction')
+    _, (best, _) = hy.short_fits(pe, declared, [refit, h], declared, pe.screen())
+    full = hy.full_fit(pe, h, best, declared)
+    assert play_closed(full) and full['drive_backlash_m'] == CLOSED_PLAY
+    assert full['drive_mass_kg'] == pytest.approx(drive['motor_mass_kg'], rel=0.01)
+    assert full['Fc'] == pytest.approx(truth['friction']['Fc'], rel=0.01)
+    assert contradictions(pe, full, 'drive_backlash') == []
+    assert pv.summary(full)['x_rms_counts'] < 5.0
+
 
 @pytest.mark.slow
 def test_a_declared_beta_above_the_whole_viscous_term_is_corrected_with_eps_held_at_0(tmp_path):

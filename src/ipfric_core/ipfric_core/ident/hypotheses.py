@@ -20,7 +20,7 @@ import numpy as np
 from .effects import EFFECTS
 from .model import LADDER_EFFECTS, LAW_PARAMS, Model
 from .problem import SCREEN_NFEV, Problem, fit_model
-from .refutations import SIZE, bound_params, contradictions, smallest_play, untold
+from .refutations import CLOSED_PLAY, bound_params, contradictions, size_params, smallest_play, untold
 from .starts import (
     bristle_starts,
     contact_damping,
@@ -32,8 +32,8 @@ from .starts import (
 )
 
 __all__ = ['refit_of', 'LAWS', 'PLANT_CORRECTIONS', 'CORRECTABLE', 'Hypothesis', 'hypotheses', 'heavier_cart',
-           'in_place_of_mass', 'short_fit', 'short_fits', 'joint', 'full_fit', 'beta_for_eps', 'contact_held',
-           'errors_of', 'screen']
+           'in_place_of_mass', 'with_play_closed', 'short_fit', 'short_fits', 'joint', 'full_fit', 'beta_for_eps',
+           'contact_held', 'errors_of', 'screen']
 
 #: the friction laws the ladder weighs against each other
 LAWS = ('viscous', 'coulomb', 'exponential', 'dynamic')
@@ -136,8 +136,11 @@ def hypotheses(pe: Problem, current: Model, declared: Model, allowed=None, balan
         if name == 'drive_backlash':   # a motor side lighter than this is no drive (and its contact rings at kHz)
             base = base.with_bounds('drive_mass_kg', MIN_DRIVE_SHARE * current['M'], math.inf)
         out.append(Hypothesis(name, 'effect', base.with_free(levels), own, own + levels, starts, name))
-        if name == 'drive_backlash' and heavier is not None:
-            out.append(in_place_of_mass(pe, heavier, declared, 'M' if current.param('M').free else 'alpha'))
+        if name == 'drive_backlash':
+            out.append(with_play_closed(pe, out[-1], declared))
+            if heavier is not None:
+                out.append(in_place_of_mass(pe, heavier, declared, 'M' if current.param('M').free else 'alpha'))
+                out.append(with_play_closed(pe, out[-1], heavier, [heavier['M'] - declared['M']]))
         if not refitted:
             out.append(Hypothesis(f'{name} on the declared friction', 'effect', base, own, own, starts, name))
     return out
@@ -197,6 +200,23 @@ def in_place_of_mass(pe: Problem, current: Model, declared: Model, corrected: st
     own, law = EFFECTS[name].params, current.law_fitted()
     return Hypothesis(f'{name} in place of {corrected} corrected', 'effect', base.with_free(law), own, own + law,
                       starts, name, screened=False)
+
+
+def with_play_closed(pe: Problem, h: Hypothesis, prior: Model, masses: list | None = None) -> Hypothesis:
+    """The drive of ``h`` with its play held closed (CLOSED_PLAY): a compliant contact without play, a
+    motor side that moves with the cart through a spring and a damper (a belt, a rack's teeth under
+    preload). A play below two encoder counts is refuted (the readings' rounding), and a rigid contact is a
+    heavier cart; between the two, a motor side behind a play the encoder cannot show rings against the cart
+    (seed 2027's cases 71 and 106, plays of 0.5 and 0.25 counts: a mass correction left 25 and 13 counts on
+    validation, the drive with its play closed 1.8 and 0.6). Started from the best contacts of
+    :func:`drive_starts` at the closed play (``masses``: the motor sides [kg] to try, as ``h``'s); its
+    label says it."""
+    name = 'drive_backlash_m'
+    model = h.model.holding({name: CLOSED_PLAY})
+    starts = drive_starts(pe, model, prior, masses=masses, gaps=[CLOSED_PLAY])
+    label = h.label.replace('drive_backlash', 'drive_backlash with its play closed', 1)
+    return Hypothesis(label, h.kind, model, tuple(n for n in h.own if n != name), tuple(n for n in h.free if n != name),
+                      starts, h.effect, screened=h.screened)
 
 
 def short_fit(pe: Problem, current: Model, h: Hypothesis, prior: Model, ps: Problem) -> tuple[Model, float]:
@@ -352,7 +372,7 @@ def contact_held(model: Model) -> dict:
 def errors_of(pe: Problem, h: Hypothesis, model: Model, prior: Model, among=None) -> dict:
     """The standard errors of a fitted hypothesis's parameters at its fit (no step taken: the Jacobian
     there, checked along each parameter of its own, or of those of them in ``among``; :func:`fit_model`)."""
-    profile = set(SIZE.get(h.effect or '', ())) | set(h.own)
+    profile = set(size_params(model, h.effect or '')) | set(h.own)
     return fit_model(pe, model, max_nfev=0, only=joint(h, model), prior=prior,
                      profile=profile if among is None else profile & set(among))[1]
 

@@ -32,7 +32,7 @@ from .hypotheses import CORRECTABLE, Hypothesis, errors_of, full_fit, hypotheses
 from .judging import WORSE_PERCENT, Judged, beyond_refit, contribution, drop_checks, judge, leaner_first, verdict
 from .model import FRICTION_FITTED, LAW_PARAMS, Model
 from .problem import Problem, fit_model
-from .refutations import near, uncorrected, unfit, unresolved, untold
+from .refutations import CLOSED_PLAY, near, play_closed, uncorrected, unfit, unresolved, untold
 from .starts import DRIVE_GRID, balance_starts
 
 __all__ = ['Step', 'run_ladder']
@@ -40,7 +40,6 @@ __all__ = ['Step', 'run_ladder']
 MAX_ROUNDS = 4
 CONTRIBUTION_COUNTS = 2.0  # a kept hypothesis changes the simulated motion by this much at least [counts RMS]
 REFIT_NOTE = 0.3         # a refit that moves a declared value by more than 30 % is reported
-CLOSED_PLAY = 1e-9       # a drive's play closed [m]: a compliant contact without play (0 takes the drive away)
 
 
 def confirm(pe: Problem, pv: Problem, current: Model, j: Judged, prior: Model) -> bool:
@@ -70,7 +69,15 @@ def play_checks(pe: Problem, pv: Problem, j: Judged, prior: Model, size: list[st
     told from zero or not (``size``: :func:`unresolved`'s reasons) may be decided so (:func:`profiled`):
     refused where the closed one replays the validation data better (the play a local minimum of the fit);
     a play within two standard errors of zero told from zero by that profile (the report says so in
-    ``j.notes``) or, where it is not, refused with both reasons. Returns the reasons about its size."""
+    ``j.notes``) or, where it is not, refused with both reasons. A drive whose play is held closed (a
+    compliant contact without play, :func:`hypotheses.with_play_closed`) has no play to judge: the report
+    says what it is. Returns the reasons about its size."""
+    if play_closed(j.model):
+        if not size:
+            j.notes.append(f'a compliant drive without play: the motor side, {j.model["drive_mass_kg"]:.4g} kg, '
+                           f'moves with the cart through a contact of {j.model["drive_stiffness_N_per_m"]:.4g} N/m '
+                           f'(the play held closed, {CLOSED_PLAY:g} m)')
+        return size
     if size and not profiled(j.model, j.std):
         return size
     dropped, left, better = closed_play(pe, pv, j, prior)

@@ -21,9 +21,11 @@ __all__ = ['SIZE', 'RIPPLE_PERIODS', 'valid_moves', 'stops_and_starts', 'smalles
            'response_lag',
            'crossings', 'unseen', 'drive_crossings', 'widest_play',
            'contradictions', 'unresolved', 'near', 'uncorrected', 'rest_offset', 'no_static_level', 'bound_params',
-           'on_bounds', 'untold', 'reversals', 'never_starts', 'unfit', 'smallest_play']
+           'on_bounds', 'untold', 'reversals', 'never_starts', 'unfit', 'smallest_play', 'CLOSED_PLAY', 'play_closed',
+           'size_params']
 
 PLAY_COUNTS = 2.0        # a play (the encoder's or a drive's) below this many encoder counts is quantization
+CLOSED_PLAY = 1e-9       # a drive's play closed [m]: a compliant contact without play (0 takes the drive away)
 UNDO_SIGMA = 2.0         # a correction that ends this many standard errors from the declared value or closer is undone
 STOP_S = 0.05            # a stretch this long with the encoder still is a stop [s]
 BREAKAWAY_S = 0.5        # a cart that starts from rest travels three counts within this long [s]
@@ -184,7 +186,7 @@ def contradictions(pr: Problem, model: Model, name: str) -> list[str]:
             why.append(f'play {model["backlash_m"] * 1e3:.3g} mm: the readings turn within {limit[1] * 1e3:.3g} ms '
                        f'(median of their turns) and never move faster than {limit[2]:.3g} m/s, so the encoder '
                        f'crosses {limit[0] * 1e3:.3g} mm at most')
-    if name == 'drive_backlash':
+    if name == 'drive_backlash' and not play_closed(model):
         if model['drive_backlash_m'] < smallest_play(rec):
             why.append(f'drive play {model["drive_backlash_m"] * 1e3:.3g} mm is below two encoder counts '
                        f'(quantization)')
@@ -204,14 +206,30 @@ SIZE = {'deadzone': ('deadzone_V',), 'delay': ('input_delay_s',), 'cogging': ('c
         'sensor_bias': ('bias_theta_rad',), 'backlash': ('backlash_m',), 'drive_backlash': ('drive_backlash_m',)}
 
 
+def play_closed(model: Model) -> bool:
+    """Whether ``model``'s drive has its play held closed (CLOSED_PLAY): a compliant contact without play."""
+    if 'drive_backlash' not in model.effects:
+        return False
+    p = model.param('drive_backlash_m')
+    return not p.free and p.value <= CLOSED_PLAY
+
+
+def size_params(model: Model, name: str) -> tuple:
+    """The parameters that give effect ``name`` its size in ``model`` (:data:`SIZE`); a drive whose play is
+    held closed has no play to tell from zero: its motor side gives it its size."""
+    return ('drive_mass_kg',) if name == 'drive_backlash' and play_closed(model) else SIZE.get(name, ())
+
+
 def unresolved(model: Model, std: dict, name: str) -> list[str]:
-    """The effect's size is not told from zero: every size parameter within two standard errors."""
-    stds = [std.get(k) for k in SIZE.get(name, ())]
+    """The effect's size is not told from zero: every size parameter (:func:`size_params`) within two
+    standard errors."""
+    names = size_params(model, name)
+    stds = [std.get(k) for k in names]
     if not stds:
         return []
     if any(s is None or not math.isfinite(s) for s in stds):
         return ['its size has no standard error (the data do not determine it)']
-    sizes = [(k, model[k], float(s or 0.0)) for k, s in zip(SIZE[name], stds)]
+    sizes = [(k, model[k], float(s or 0.0)) for k, s in zip(names, stds)]
     if all(abs(v) <= 2 * s for _, v, s in sizes):
         return ['its size is within two standard errors of zero (' +
                 ', '.join(f'{k} = {v:.3g} +/- {s:.2g}' for k, v, s in sizes) + ')']
