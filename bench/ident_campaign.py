@@ -65,7 +65,8 @@ THRESHOLD = 2.0          # counts RMS: an effect's contribution from which it mu
 #: heavier by the motor side
 MIN_PLAY_COUNTS = 2.0
 #: the answer of a drive whose play the final model holds closed (a compliant contact without play): the two-mass
-#: drive of a play the encoder shows no play of, named with its ringing; a drive whose play it does show, missed
+#: drive of a play the encoder shows no play of or that does less than the threshold beyond the contact, named
+#: with its ringing; a drive whose play does more, missed
 CLOSED_DRIVE = 'drive_backlash (play closed)'
 BINS = (0.0, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 1000.0, math.inf)
 TIMEOUT = 1800.0
@@ -82,7 +83,10 @@ def components(truth: dict, threshold: float = THRESHOLD) -> list[dict]:
     """Every undeclared discrepancy of a case: effects and a wrong declared constant. A two-mass drive
     whose play alone (truth ``play_contribution_counts_rms``: the drive against its motor side fixed to
     the cart) stays below ``threshold``, or whose play is under MIN_PLAY_COUNTS encoder counts, is a cart
-    heavier by the motor side's mass: ``M corrected``; else it
+    heavier by the motor side's mass: ``M corrected`` (or, under MIN_PLAY_COUNTS, the drive with its play
+    closed, :data:`CLOSED_DRIVE`, alike); one whose play does less than ``threshold`` beyond the same drive
+    with its play closed (truth ``closed_contribution_counts_rms``) is a compliant contact without play:
+    :data:`CLOSED_DRIVE` (the drive with its play named, alike); else it
     counts by its play alone (the heavier cart takes the rest over). A deadzone counts by what neither
     model without it takes over: the smaller of its whole contribution and what it does beyond a Coulomb
     level higher by alpha dz (truth ``beyond_friction_counts_rms``: the friction every identification
@@ -100,6 +104,11 @@ def components(truth: dict, threshold: float = THRESHOLD) -> list[dict]:
                    if play < MIN_PLAY_COUNTS else f'a drive play of {part:.2g} counts')
             comp.update(name='M corrected', detail=f'{why}: the motor side ({v["motor_mass_kg"]:.3g} kg) moves '
                         'with the cart', alike=[CLOSED_DRIVE] if play < MIN_PLAY_COUNTS else [])
+        elif k == 'drive_backlash' and threshold <= comp['counts'] and part is not None and \
+                v.get('closed_contribution_counts_rms', math.inf) < threshold:
+            comp.update(name=CLOSED_DRIVE, counts=min(comp['counts'], float(part)), alike=['drive_backlash'],
+                        detail=f'a drive play of {part:.2g} counts beyond a heavier cart, '
+                               f'{v["closed_contribution_counts_rms"]:.2g} beyond its contact with the play closed')
         elif part is not None:
             comp.update(counts=min(comp['counts'], float(part)),
                         detail=f'{comp["counts"]:.3g} counts, {part:.3g} of them beyond {nearer}')

@@ -207,6 +207,13 @@ def test_a_drive_whose_play_is_not_seen_expects_the_mass_of_its_motor_side():
     assert scorer.expected_answer(tiny, 2.0)['label'] == 'drive_backlash'
     assert scorer.outcome(scorer.expected_answer(tiny, 2.0), scorer.predicted_answer(closed)) == 'wrong'
     assert scorer.outcome(hidden, scorer.predicted_answer(closed)) == 'wrong'   # its play unseen for its size only
+    # a play that does less than the threshold beyond the same drive with its play closed: a compliant contact
+    tiny['effects']['drive_backlash']['closed_contribution_counts_rms'] = 1.2
+    contact = scorer.expected_answer(tiny, 2.0)
+    assert contact['label'] == scorer.CLOSED_DRIVE
+    assert scorer.outcome(contact, scorer.predicted_answer(closed)) == 'correct'
+    assert scorer.outcome(contact, scorer.predicted_answer(play)) == 'alike'       # its play named: the same drive
+    assert scorer.outcome(contact, scorer.predicted_answer(mass)) == 'wrong'       # its ringing is left
 
 
 def test_standard_errors_are_checked_against_the_truth_on_clean_cases():

@@ -43,7 +43,8 @@ hanging or upright); sample overruns repeat the previous readings; jittered stam
 sample instants.
 
 Parts of an effect that a declared parameter takes over: a drive's play alone
-(``play_contribution_counts_rms``: against its motor side fixed to the cart, a heavier cart) and a
+(``play_contribution_counts_rms``: against its motor side fixed to the cart, a heavier cart;
+``closed_contribution_counts_rms``: against the same drive with its play closed, a compliant contact) and a
 deadzone beyond the friction (``beyond_friction_counts_rms``: against a Coulomb and static level
 higher by alpha dz, what the deadzone is while the cart moves the way it is driven).
 
@@ -869,6 +870,12 @@ def contributions(spec, data):
             d = (x_with - _replay(t, volt, Y2, ST, starts, p2, inp2, presc, hmax)) / rig["x_res"]
             a, b, _ = rms(d)
             out[name].update(play_contribution_counts_rms=a, play_contribution_counts_rms_validation=b)
+            # and beyond a compliant contact without play: the same drive with its play closed (gap 0)
+            closed = dict(full, drive_backlash=dict(q, gap_m=0.0))
+            p2, inp2 = _pvec(spec, closed)
+            d = (x_with - _replay(t, volt, Y, ST, starts, p2, inp2, presc, hmax)) / rig["x_res"]
+            a, b, _ = rms(d)
+            out[name].update(closed_contribution_counts_rms=a, closed_contribution_counts_rms_validation=b)
     pe = spec.get("plant_error")
     if pe is not None:
         wrong = dict(rig, **{pe["name"]: pe["declared"]})
