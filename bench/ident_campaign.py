@@ -142,9 +142,10 @@ def expected_answer(truth: dict, threshold: float = THRESHOLD) -> dict:
 def predicted_answer(result: dict | None) -> dict:
     if result is None:
         return dict(label='error', added=[], verdict=None)
+    from ipfric_core.ident.refutations import CLOSED_PLAY
     final = {p['name']: p for p in (result.get('ladder') or [{}])[-1].get('params', [])}
     play = final.get('drive_backlash_m')
-    closed = play is not None and not play['fitted'] and play['value'] <= 1e-9
+    closed = play is not None and not play['fitted'] and play['value'] <= CLOSED_PLAY
     added = sorted([CLOSED_DRIVE if e == 'drive_backlash' and closed else e
                     for e in result.get('effects_added', []) if e not in FRICTION_PARTS]
                    + [f'{n} corrected' for n in result.get('constants_corrected', []) if n not in EQUIVALENT])
