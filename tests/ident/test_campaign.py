@@ -414,6 +414,37 @@ def test_a_motor_side_behind_a_play_below_the_encoders_rings_through_a_contact_w
 
 
 @pytest.mark.slow
+def test_a_drives_grid_is_ranked_at_the_refits_friction_too(tmp_path):
+    """Seed 2027, case 138: a balancing loop at 5.7 ms, 0.23 kg on a motor side behind a 0.40 mm play,
+    the friction declared far off (the campaign declares none: Coulomb level 0.65 N against 2.0). Ranked at
+    the declared friction alone, the drive's grid points short-fit to more than the refit's estimation
+    error; ranked at the refit's friction too, as the ladder's first round ranks them, the drive's short fit
+    lowers it by more than half (two thirds)."""
+    from dataclasses import replace
+
+    from ipfric_core.analysis.records import load
+    from ipfric_core.ident import hypotheses as hy
+    from ipfric_core.ident.model import load_declared
+    from ipfric_core.ident.problem import Problem
+    from ipfric_core.physics.params import PlantParams
+    campaign.generate(tmp_path, 0, 2027, indices=[138])
+    d = tmp_path / campaign.case_name(138)
+    truth = json.loads((d / 'truth.json').read_text())
+    est, _ = load(d / 'data.csv', PlantParams(**truth['constants']), None, False).split(0.6)
+    declared = load_declared(None, 'exponential', True, PlantParams(**truth['constants']))
+    pe = Problem(est)
+    ps = pe.screen()
+    hs = hy.hypotheses(pe, declared, declared)
+    refit = next(h for h in hs if h.kind == 'friction')
+    drive = next(h for h in hs if h.label == 'drive_backlash')
+    assert drive.grid == {}
+    (fitted, _), (best, _) = hy.short_fits(pe, declared, [refit, drive], declared, ps)
+    assert pe.cost(best) < 0.5 * pe.cost(fitted)
+    _, (alone, _) = hy.short_fits(pe, declared, [refit, replace(drive, grid=None)], declared, ps)
+    assert pe.cost(alone) > pe.cost(fitted)
+
+
+@pytest.mark.slow
 def test_a_declared_beta_above_the_whole_viscous_term_is_corrected_with_eps_held_at_0(tmp_path):
     """Seed 2027, case 0 (the cart alone, clean; 30 s), identified with beta declared 1.5 times its true value:
     the data want a viscous term beta + eps (7.41 N s/m) below the declared beta (8.90), which the viscous
