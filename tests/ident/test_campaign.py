@@ -445,6 +445,39 @@ def test_a_drives_grid_is_ranked_at_the_refits_friction_too(tmp_path):
 
 
 @pytest.mark.slow
+def test_a_kept_compliant_drive_has_its_play_opened_in_the_next_round(tmp_path):
+    """Seed 2027, case 191: the cart alone at 4 ms, 0.457 kg on a motor side behind a 0.046 mm play (4.1
+    counts) and a contact of 4.6e5 N/m. The ladder's round 1 kept the drive with its play closed at a soft
+    contact (the values below: 4.6e4 N/m, 5.07 counts left on validation); the next round opens its play
+    from the contacts the grid ranks best at that motor side, and reaches the play within 30 % and half
+    the closed drive's validation error."""
+    from ipfric_core.analysis.records import load
+    from ipfric_core.ident import hypotheses as hy
+    from ipfric_core.ident.model import LAW_PARAMS, load_declared
+    from ipfric_core.ident.problem import Problem
+    from ipfric_core.ident.refutations import CLOSED_PLAY
+    from ipfric_core.physics.params import PlantParams
+    campaign.generate(tmp_path, 0, 2027, indices=[191])
+    d = tmp_path / campaign.case_name(191)
+    truth = json.loads((d / 'truth.json').read_text())
+    plant = PlantParams(**truth['constants'])
+    est, val = load(d / 'data.csv', plant, None, True).split(0.6)
+    declared = load_declared(None, 'exponential', False, plant)
+    kept = {'Fc': 0.4719, 'Fs_excess': 0.07504, 'eps': 2.829, 'v_s': 0.0604, 'drive_mass_kg': 0.4567,
+            'drive_stiffness_N_per_m': 4.59e4, 'drive_damping_Ns_per_m': 0.9458}
+    current = declared.with_effect('drive_backlash').with_values(kept) \
+        .with_free(LAW_PARAMS[declared.law] + ('drive_mass_kg', 'drive_stiffness_N_per_m', 'drive_damping_Ns_per_m')) \
+        .holding({'drive_backlash_m': CLOSED_PLAY})
+    pe, pv = Problem(est), Problem(val)
+    h = next(h for h in hy.hypotheses(pe, current, declared) if h.label == 'drive_backlash with its play opened')
+    assert h.starts[0] == {'drive_backlash_m': 2 * est.x_resolution}
+    best, _ = hy.short_fit(pe, current, h, declared, pe.screen())
+    full = hy.full_fit(pe, h, best, declared)
+    assert full['drive_backlash_m'] == pytest.approx(truth['effects']['drive_backlash']['gap_m'], rel=0.3)
+    assert pv.summary(full)['x_rms_counts'] < 0.5 * pv.summary(current)['x_rms_counts']
+
+
+@pytest.mark.slow
 def test_a_declared_beta_above_the_whole_viscous_term_is_corrected_with_eps_held_at_0(tmp_path):
     """Seed 2027, case 0 (the cart alone, clean; 30 s), identified with beta declared 1.5 times its true value:
     the data want a viscous term beta + eps (7.41 N s/m) below the declared beta (8.90), which the viscous

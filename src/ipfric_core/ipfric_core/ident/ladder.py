@@ -141,9 +141,12 @@ def as_refit(pe: Problem, pv: Problem, current: Model, j: Judged, prior: Model, 
 
 
 def undone(j: Judged, current: Model) -> Model:
-    """``j``'s model without what its hypothesis adds: the effect removed, a plant correction's constant
+    """``j``'s model without what its hypothesis adds: the effect removed (an effect ``current`` has, a drive
+    whose play it opens, back at ``current``'s values), a plant correction's constant
     back at its value in ``current`` with the friction as fitted beside it (a mass corrected by 0.1 % that
     rode in on the refit's friction is no correction), a law or a refit ``current`` itself."""
+    if j.h.effect in current.effects:    # a drive's play opened (:func:`hypotheses.with_play_opened`)
+        return j.model.with_values({n: current[n] for n in j.h.own})
     if j.h.effect:
         return j.model.without(j.h.effect)
     if j.h.kind == 'plant':
