@@ -449,10 +449,12 @@ def test_a_kept_compliant_drive_has_its_play_opened_in_the_next_round(tmp_path):
     """Seed 2027, case 191: the cart alone at 4 ms, 0.457 kg on a motor side behind a 0.046 mm play (4.1
     counts) and a contact of 4.6e5 N/m. The ladder's round 1 kept the drive with its play closed at a soft
     contact (the values below: 4.6e4 N/m, 5.07 counts left on validation); the next round opens its play
-    from the contacts the grid ranks best at that motor side, and reaches the play within 30 % and half
-    the closed drive's validation error."""
+    from the contacts the grid ranks best at that motor side, reaches the play within 30 % and half the
+    closed drive's validation error, and passes its checks (its play against itself closed among them)."""
     from ipfric_core.analysis.records import load
     from ipfric_core.ident import hypotheses as hy
+    from ipfric_core.ident.judging import judge
+    from ipfric_core.ident.ladder import confirm
     from ipfric_core.ident.model import LAW_PARAMS, load_declared
     from ipfric_core.ident.problem import Problem
     from ipfric_core.ident.refutations import CLOSED_PLAY
@@ -475,6 +477,9 @@ def test_a_kept_compliant_drive_has_its_play_opened_in_the_next_round(tmp_path):
     full = hy.full_fit(pe, h, best, declared)
     assert full['drive_backlash_m'] == pytest.approx(truth['effects']['drive_backlash']['gap_m'], rel=0.3)
     assert pv.summary(full)['x_rms_counts'] < 0.5 * pv.summary(current)['x_rms_counts']
+    j = judge(pe, pv, current, h, full, None, pv.window_sse(current))
+    confirm(pe, pv, current, j, declared)
+    assert j.refused == [] and any(n.startswith('the play of the compliant drive opened') for n in j.notes)
 
 
 @pytest.mark.slow

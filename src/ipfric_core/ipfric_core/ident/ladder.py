@@ -60,6 +60,11 @@ def confirm(pe: Problem, pv: Problem, current: Model, j: Judged, prior: Model) -
         if size < CONTRIBUTION_COUNTS:
             why.append(f'it changes the simulated motion by {size:.2g} counts RMS (needs {CONTRIBUTION_COUNTS:g}: '
                        f'too small to matter at the encoders)')
+        elif j.h.effect in current.effects:      # a drive's play opened (hypotheses.with_play_opened)
+            j.notes.append(f'the play of the compliant drive opened: {j.model["drive_backlash_m"] * 1e3:.4g} mm, '
+                           f'the contact {j.model["drive_stiffness_N_per_m"]:.4g} N/m (with its play closed '
+                           f'{current["drive_stiffness_N_per_m"]:.4g}); it changes the simulated motion by {size:.2g} '
+                           'counts RMS')
     j.refused += why
     return bool(corrected) and why == corrected
 
