@@ -143,7 +143,7 @@ def hypotheses(pe: Problem, current: Model, declared: Model, allowed=None, balan
         out.append(Hypothesis(name, 'effect', base.with_free(levels), own, own + levels, starts, name,
                               grid={} if name == 'drive_backlash' else None))
         if name == 'drive_backlash':
-            out.append(with_play_closed(pe, out[-1], (declared, current)))
+            out.append(with_play_closed(pe, out[-1], (current,)))
             if heavier is not None:
                 out.append(in_place_of_mass(pe, heavier, declared, 'M' if current.param('M').free else 'alpha'))
                 out.append(with_play_closed(pe, out[-1], (heavier,), [heavier['M'] - declared['M']]))
@@ -300,8 +300,8 @@ def short_fits(pe: Problem, current: Model, hs: list[Hypothesis], prior: Model, 
     from the clipping fitted on the declared friction the law reached the truth and 0.45 counts). A plant
     correction, which refits the whole law itself, starts from both: a refit without it may have bent the
     friction to make up for a wrong mass (a motor side that moves with the cart: the viscous slope sank to
-    0). A drive's starts carry their friction (:func:`drive_starts`): its grid is also ranked at the refit's,
-    and those points start from it."""
+    0). A drive's starts carry their friction (:func:`drive_starts`): its grid is also ranked at the refit's
+    (on the screen's windows), and those points start from it."""
     out: dict[int, tuple[Model, float]] = {i: short_fit(pe, current, h, prior, ps)
                                            for i, h in enumerate(hs) if h.kind == 'friction'}
     seed = {}
@@ -323,7 +323,7 @@ def short_fits(pe: Problem, current: Model, hs: list[Hypothesis], prior: Model, 
         h = hs[i]
         if seed:
             own = on_declared.get(h.effect)
-            grid = drive_starts(pe, h.model, (refit,), **h.grid) if h.grid is not None else []
+            grid = drive_starts(ps, h.model, (refit,), **h.grid) if h.grid is not None else []
             h = replace(h, model=h.model.with_free(law), starts=[{**seed, **st} for st in h.starts + grid]
                         + ([{n: own[n] for n in h.own}] if own is not None else []))
         hs[i] = h

@@ -38,7 +38,7 @@ def effect_starts(pr: Problem, model: Model, name: str, prior: Model) -> list[di
     if name == 'backlash':
         return [{'backlash_m': g} for g in (3e-4, 1e-3, 3e-3)]
     if name == 'drive_backlash':
-        return drive_starts(pr, model, (prior, model))
+        return drive_starts(pr, model, (model,))
     if name == 'sensor_bias':
         return [{'bias_theta_rad': rest_offset(rec.theta) if rec.theta is not None else 0.0}]
     if name == 'lag':
@@ -144,9 +144,10 @@ DRIVE_GRID = ((3e-4, 1e-3, 3e-3), (0.1, 0.25, 0.5), (50.0, 100.0, 200.0), 0.15)
 def drive_starts(pr: Problem, model: Model, frictions, keep: int = 2, masses=None, gaps=None) -> list[dict]:
     """Start values of a drive with play: the ``keep`` best points of :data:`DRIVE_GRID` by the
     cart's estimation error (its error has many local minima: each contact frequency rings differently)
-    at each friction of ``frictions`` (models: their law's values, each start carrying them): the declared
-    model's (a refit without the play distorts it: the Coulomb level sinks where the cart coasts through
-    the play), and a refit's or an earlier round's, where the declared friction is far off (seed 2027's
+    at each friction of ``frictions`` (models: their law's values, each start carrying them): the current
+    model's (in round 1 the declared one: a refit without the play distorts it, the Coulomb level sinks
+    where the cart coasts through the play), and in round 1 the refit's too, where the declared friction is
+    far off (seed 2027's
     case 138, a 0.40 mm play with 0.23 kg on its motor side in a balancing loop, declared Coulomb level 0.65
     N against 2.0: at the declared friction the grid's best points had a motor side of 0.63 kg and their
     short fits left 930-1090 counts on validation; at the refit's, 0.125 kg and 124-171). ``masses``: the
