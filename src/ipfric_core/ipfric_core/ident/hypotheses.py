@@ -219,7 +219,7 @@ def with_play_closed(pe: Problem, h: Hypothesis, frictions, masses: list | None 
     sides [kg] to try, as ``h``'s); its label says it."""
     name = 'drive_backlash_m'
     model = h.model.holding({name: CLOSED_PLAY})
-    grid = {'masses': masses, 'gaps': [CLOSED_PLAY]}
+    grid: dict = {'masses': masses, 'gaps': [CLOSED_PLAY]}
     starts = drive_starts(pe, model, frictions, **grid)
     label = h.label.replace('drive_backlash', 'drive_backlash with its play closed', 1)
     return Hypothesis(label, h.kind, model, tuple(n for n in h.own if n != name), tuple(n for n in h.free if n != name),
