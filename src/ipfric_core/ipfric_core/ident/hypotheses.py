@@ -136,17 +136,17 @@ def hypotheses(pe: Problem, current: Model, declared: Model, allowed=None, balan
         if EFFECTS[name].needs_theta and rec.theta is None:
             continue
         own = EFFECTS[name].params
-        starts = effect_starts(pe, current, name, declared)
+        starts = effect_starts(pe, current, name)
         base = current.with_effect(name)
         if name == 'drive_backlash':   # a motor side lighter than this is no drive (and its contact rings at kHz)
             base = base.with_bounds('drive_mass_kg', MIN_DRIVE_SHARE * current['M'], math.inf)
         out.append(Hypothesis(name, 'effect', base.with_free(levels), own, own + levels, starts, name,
                               grid={} if name == 'drive_backlash' else None))
         if name == 'drive_backlash':
-            out.append(with_play_closed(pe, out[-1], (current,)))
+            out.append(with_play_closed(pe, out[-1], current))
             if heavier is not None:
                 out.append(in_place_of_mass(pe, heavier, declared, 'M' if current.param('M').free else 'alpha'))
-                out.append(with_play_closed(pe, out[-1], (heavier,), [heavier['M'] - declared['M']]))
+                out.append(with_play_closed(pe, out[-1], heavier, [heavier['M'] - declared['M']]))
         if not refitted:
             out.append(Hypothesis(f'{name} on the declared friction', 'effect', base, own, own, starts, name))
     return out
@@ -202,25 +202,25 @@ def in_place_of_mass(pe: Problem, current: Model, declared: Model, corrected: st
     extra = current['M'] - declared['M']
     smallest = smallest_play(pe.rec)
     gaps = ((smallest,) if smallest < IN_PLACE_GAPS[0] else ()) + IN_PLACE_GAPS
-    starts = [s for gap in gaps for s in drive_starts(pe, base, (current,), keep=1, masses=[extra], gaps=[gap])]
+    starts = [s for gap in gaps for s in drive_starts(pe, base, current, keep=1, masses=[extra], gaps=[gap])]
     own, law = EFFECTS[name].params, current.law_fitted()
     return Hypothesis(f'{name} in place of {corrected} corrected', 'effect', base.with_free(law), own, own + law,
                       starts, name, screened=False)
 
 
-def with_play_closed(pe: Problem, h: Hypothesis, frictions, masses: list | None = None) -> Hypothesis:
+def with_play_closed(pe: Problem, h: Hypothesis, friction: Model, masses: list | None = None) -> Hypothesis:
     """The drive of ``h`` with its play held closed (CLOSED_PLAY): a compliant contact without play, a
     motor side that moves with the cart through a spring and a damper (a belt, a rack's teeth under
     preload). A play below two encoder counts is refuted (the readings' rounding), and a rigid contact is a
     heavier cart; between the two, a motor side behind a play the encoder cannot show rings against the cart
     (seed 2027's cases 71 and 106, plays of 0.5 and 0.25 counts: a mass correction left 25 and 13 counts on
     validation, the drive with its play closed 1.8 and 0.6). Started from the best contacts of
-    :func:`drive_starts` at the closed play and each friction of ``frictions`` (``masses``: the motor
+    :func:`drive_starts` at the closed play and the friction of ``friction`` (``masses``: the motor
     sides [kg] to try, as ``h``'s); its label says it."""
     name = 'drive_backlash_m'
     model = h.model.holding({name: CLOSED_PLAY})
     grid: dict = {'masses': masses, 'gaps': [CLOSED_PLAY]}
-    starts = drive_starts(pe, model, frictions, **grid)
+    starts = drive_starts(pe, model, friction, **grid)
     label = h.label.replace('drive_backlash', 'drive_backlash with its play closed', 1)
     return Hypothesis(label, h.kind, model, tuple(n for n in h.own if n != name), tuple(n for n in h.free if n != name),
                       starts, h.effect, screened=h.screened, grid=grid)
@@ -246,7 +246,7 @@ def with_play_opened(pe: Problem, current: Model, levels: tuple) -> Hypothesis:
     counts = [c * pe.rec.x_resolution for c in OPENED_COUNTS]
     plays = counts + [g for g in IN_PLACE_GAPS if g > counts[-1]]
     model = current.with_free(('drive_backlash_m',) + levels)
-    starts = [{'drive_backlash_m': plays[0]}] + drive_starts(pe, model, (current,), masses=[current['drive_mass_kg']],
+    starts = [{'drive_backlash_m': plays[0]}] + drive_starts(pe, model, current, masses=[current['drive_mass_kg']],
                                                              gaps=plays)
     own = EFFECTS[name].params
     return Hypothesis(f'{name} with its play opened', 'effect', model, own, own + levels, starts, name, screened=False)
@@ -323,7 +323,7 @@ def short_fits(pe: Problem, current: Model, hs: list[Hypothesis], prior: Model, 
         h = hs[i]
         if seed:
             own = on_declared.get(h.effect)
-            grid = drive_starts(ps, h.model, (refit,), **h.grid) if h.grid is not None else []
+            grid = drive_starts(ps, h.model, refit, **h.grid) if h.grid is not None else []
             h = replace(h, model=h.model.with_free(law), starts=[{**seed, **st} for st in h.starts + grid]
                         + ([{n: own[n] for n in h.own}] if own is not None else []))
         hs[i] = h

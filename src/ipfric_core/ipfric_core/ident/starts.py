@@ -20,9 +20,9 @@ __all__ = ['DRIVE_GRID', 'effect_starts', 'ripple_starts', 'phased', 'drive_star
            'peak_level', 'bristle_starts', 'balance_starts', 'contact_damping']
 
 
-def effect_starts(pr: Problem, model: Model, name: str, prior: Model) -> list[dict]:
+def effect_starts(pr: Problem, model: Model, name: str) -> list[dict]:
     """Start values of effect ``name`` (several where the fit has several minima); a start may
-    also name other parameters of ``model`` (``prior``: the declared model)."""
+    also name other parameters of ``model``."""
     rec = pr.rec
     if name == 'cogging':
         return [{'cogging_period_m': p} for p in (0.002, 0.0035, 0.006, 0.01, 0.015, 0.02)] + ripple_starts(
@@ -38,7 +38,7 @@ def effect_starts(pr: Problem, model: Model, name: str, prior: Model) -> list[di
     if name == 'backlash':
         return [{'backlash_m': g} for g in (3e-4, 1e-3, 3e-3)]
     if name == 'drive_backlash':
-        return drive_starts(pr, model, (model,))
+        return drive_starts(pr, model, model)
     if name == 'sensor_bias':
         return [{'bias_theta_rad': rest_offset(rec.theta) if rec.theta is not None else 0.0}]
     if name == 'lag':
@@ -141,10 +141,10 @@ def phased(pr: Problem, model: Model, q: dict, travel: float) -> dict:
 DRIVE_GRID = ((3e-4, 1e-3, 3e-3), (0.1, 0.25, 0.5), (50.0, 100.0, 200.0), 0.15)
 
 
-def drive_starts(pr: Problem, model: Model, frictions, keep: int = 2, masses=None, gaps=None) -> list[dict]:
+def drive_starts(pr: Problem, model: Model, friction: Model, keep: int = 2, masses=None, gaps=None) -> list[dict]:
     """Start values of a drive with play: the ``keep`` best points of :data:`DRIVE_GRID` by the
     cart's estimation error (its error has many local minima: each contact frequency rings differently)
-    at each friction of ``frictions`` (models: their law's values, each start carrying them): the current
+    at the friction of model ``friction`` (its law's values, each start carrying them): the current
     model's (in round 1 the declared one: a refit without the play distorts it, the Coulomb level sinks
     where the cart coasts through the play), and in round 1 the refit's too, where the declared friction is
     far off (seed 2027's
@@ -155,24 +155,16 @@ def drive_starts(pr: Problem, model: Model, frictions, keep: int = 2, masses=Non
     instead of the grid's."""
     grid_gaps, shares, freqs, _ = DRIVE_GRID
     gaps = gaps or grid_gaps
-    points = []
+    law = {n: friction[n] for n in LAW_PARAMS[friction.law]}
+    grid = []
     for mass in masses or [share * model['M'] for share in shares]:
         reduced = mass * model['M'] / (mass + model['M'])
         for f in freqs:
             k = reduced * (2 * math.pi * f) ** 2
-            points += [{'drive_backlash_m': g, 'drive_mass_kg': mass, 'drive_stiffness_N_per_m': k,
-                        'drive_damping_Ns_per_m': contact_damping(k, mass, model['M'])} for g in gaps]
-    out: list[dict] = []
-    laws = []
-    for friction in frictions:
-        law = {n: friction[n] for n in LAW_PARAMS[friction.law]}
-        if law in laws:
-            continue
-        laws.append(law)
-        grid = [{**p, **law} for p in points]
-        costs = [pr.cart_cost(model.with_effect('drive_backlash', p).with_values(p)) for p in grid]
-        out += [grid[i] for i in np.argsort(costs)[:keep]]
-    return out
+            grid += [{'drive_backlash_m': g, 'drive_mass_kg': mass, 'drive_stiffness_N_per_m': k,
+                      'drive_damping_Ns_per_m': contact_damping(k, mass, model['M']), **law} for g in gaps]
+    costs = [pr.cart_cost(model.with_effect('drive_backlash', p).with_values(p)) for p in grid]
+    return [grid[i] for i in np.argsort(costs)[:keep]]
 
 
 def law_starts(declared: Model) -> dict:
