@@ -81,3 +81,32 @@ def test_only_a_drive_whose_motor_side_the_data_fix_has_its_play_decided_by_its_
     model = drive(declared, 2.4e-5, mass, 183.0, 0.26, {})
     std = Errors(['drive_backlash_m', 'drive_mass_kg'], np.diag([2e-5, se]) ** 2, reach)
     assert profiled(model, std) is decided
+
+
+@pytest.mark.slow
+def test_a_closed_play_is_opened_even_where_the_data_are_explained(tmp_path):
+    """The ladder stops where the data are explained to the encoders' floor, but a compliant drive held with
+    its play closed is still tried with its play open: that floor is the replay of a cart without play. A
+    clean cart of the independent simulator (30 s) declared at its true friction with 0.1 kg of it on a
+    closed drive: explained from the start, round 1 tries the opened play alone, and it is refused (the data
+    have no play)."""
+    from ipfric_core.ident.hypotheses import refinements
+    from ipfric_core.ident.judging import verdict
+    from ipfric_core.ident.ladder import run_ladder
+    from ipfric_core.ident.refutations import CLOSED_PLAY
+    rec = load(rigsim.write_case('cart_none', tmp_path, duration=30.0), None, cart_alone=True)
+    est, val = rec.split(0.6)
+    truth = rigsim.RIGS['quanser']
+    fn = truth['M'] * truth['g']
+    law = {'Fc': truth['mu_c'] * fn, 'Fs_excess': (truth['mu_s'] - truth['mu_c']) * fn, 'eps': truth['eps'],
+           'v_s': truth['v_s']}
+    base = load_declared(None, 'exponential', False)
+    closed = drive(base.with_values({'M': base['M'] - 0.1}), CLOSED_PLAY, 0.1, 200.0, 0.15, law)
+    closed = closed.holding({p.name: p.value for p in closed.params})
+    assert verdict(Problem(val), closed)['explained']
+    assert [h.label for h in refinements(Problem(est), closed)] == ['drive_backlash with its play opened']
+    assert refinements(Problem(est), closed.with_values({'drive_backlash_m': 2 * rec.x_resolution})
+                       .with_free(('drive_backlash_m',))) == []
+    out = run_ladder(est, val, closed)
+    assert [(t['round'], t['hypothesis']) for t in out['tried']] == [(1, 'drive_backlash with its play opened')]
+    assert out['tried'][0]['refused'] and [s.label for s in out['steps']] == ['declared']

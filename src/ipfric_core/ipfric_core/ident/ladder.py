@@ -5,7 +5,8 @@ hypothesis. The ladder, on one metric (the multiple-shooting simulation error of
 :mod:`ipfric_core.ident.shooting`, in encoder counts):
 
 the declared model as it is; then, round by round until the validation error is within
-reach of what the encoders' rounding alone leaves (:func:`~ipfric_core.ident.judging.verdict`) or nothing
+reach of what the encoders' rounding alone leaves (:func:`~ipfric_core.ident.judging.verdict`; then a kept
+effect's refinement is still tried: :func:`~ipfric_core.ident.hypotheses.refinements`) or nothing
 passes, every hypothesis competes against the current model (:mod:`ipfric_core.ident.hypotheses`): its
 friction refitted (known constants frozen unless freed by name: a freed one is fitted first, whatever the
 verdict, and that fit is refused as any other is when a parameter ends on its bound, its Coulomb level is
@@ -28,7 +29,18 @@ from dataclasses import dataclass
 
 from ..analysis.records import Record
 from .effects import PARAMS
-from .hypotheses import CORRECTABLE, Hypothesis, errors_of, full_fit, hypotheses, joint, refit_of, screen, short_fits
+from .hypotheses import (
+    CORRECTABLE,
+    Hypothesis,
+    errors_of,
+    full_fit,
+    hypotheses,
+    joint,
+    refinements,
+    refit_of,
+    screen,
+    short_fits,
+)
 from .judging import WORSE_PERCENT, Judged, beyond_refit, contribution, drop_checks, judge, leaner_first, verdict
 from .model import FRICTION_FITTED, LAW_PARAMS, Model
 from .problem import Problem, fit_model
@@ -246,10 +258,11 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
     ps = pe.screen()
     balance = balance_starts(est, declared) if not declared.free else {}
     for round_no in range(1, MAX_ROUNDS + 1):
-        if verdict(pv, current)['explained']:
+        explained = verdict(pv, current)['explained']     # then only a kept effect's refinement is tried
+        hs = refinements(pe, current) if explained else hypotheses(pe, current, declared, allowed, balance)
+        if not hs:
             break
         sse0_v = pv.window_sse(current)
-        hs = hypotheses(pe, current, declared, allowed, balance)
         short = short_fits(pe, current, hs, declared, ps)
         notes = screen(hs, short, pe, current)
         judged = []
