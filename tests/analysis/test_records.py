@@ -248,25 +248,3 @@ def test_an_angle_whose_equation_does_not_show_is_read_as_written_and_said_so(tm
     notes = ' '.join(load(tmp_path / 'flat.csv', None).notes)
     assert 'does not show where its angle is zero' in notes and 'nor can degrees or x and theta swapped' in notes
 
-
-def test_the_estimation_and_validation_parts_are_cut_at_a_rest_not_in_a_move():
-    """Nine moves of 0.1 m with the sixth 0.2 m long, each followed by 0.5 s at rest: 60 % of the motion is
-    reached half-way through the long move; the cut moves to the rest after it (70 % of the motion), so
-    that the move is whole in the estimation part. A record that never rests is cut at its share."""
-    from ipfric_core.analysis.records import Record
-    dt, count = 1e-3, 1e-5
-    x, pos = [], 0.0
-    for k, size in enumerate([0.1] * 5 + [0.2] + [0.1] * 3):
-        ramp = pos + (size if k % 2 == 0 else -size) * (1 - np.cos(np.linspace(0, np.pi, 400))) / 2
-        pos = ramp[-1]
-        x += [ramp, np.full(500, pos)]
-    x = np.round(np.concatenate(x) / count) * count
-    t = np.arange(len(x)) * dt
-    rec = Record('moves', t, x, np.zeros_like(x), 1.0)
-    est, val = rec.split(0.6)
-    moved = rec.motion()
-    assert moved[len(est.t)] / moved[-1] == pytest.approx(0.7, abs=0.002)
-    assert np.ptp(x[len(est.t) - 200:len(est.t) + 200]) == 0.0       # in the middle of the rest
-    sine = Record('sine', t, np.round(0.1 * np.sin(t) / count) * count, np.zeros_like(x), 1.0)
-    est, _ = sine.split(0.6)
-    assert sine.motion()[len(est.t)] / sine.motion()[-1] == pytest.approx(0.6, abs=0.002)

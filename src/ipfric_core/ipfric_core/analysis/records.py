@@ -37,14 +37,6 @@ MIN_SAMPLES = 200
 #: stamps whose longest period is more than this many times their shortest are uneven
 UNEVEN_RATIO = 1.5
 MIN_PART_COUNTS = 100   # encoder counts an estimation or validation part must move at least
-#: a split between estimation and validation moves to the middle of the rest of the cart (its encoder still
-#: for SPLIT_REST_S at least) that ends the move it cuts, else of the rest before it, within SPLIT_REACH of
-#: the record's motion: a move cut in two leaves its start to one part and its end to the other, and the
-#: windows at the cut are lost to both (seed 2027's case 175: the one move of the estimation part whose
-#: command a 5.4 V amplifier clipped, 12 % of the motion, was cut 0.15 s after its start, and the
-#: estimation windows held no clipping)
-SPLIT_REACH = 0.1
-SPLIT_REST_S = 0.1
 MAX_ROWS = 2_000_000    # a longer CSV is refused (33 min at 1 kHz; identification would take hours)
 MAX_VOLTAGE = 100.0     # |u| beyond this is not a drive command [V] (lab drives give 5-48 V)
 MAX_CART_SPEED = 10.0   # a position step faster than this between two rows is a corrupt row [m/s]
@@ -120,28 +112,14 @@ class Record:
             steps = steps + np.abs(np.diff(self.theta)) / self.theta_resolution
         return np.concatenate([[0.0], np.cumsum(np.where(self.valid_mask[1:], steps, 0.0))])
 
-    def rests(self) -> list[tuple[int, int]]:
-        """The samples [a, b) where the cart's encoder stands still for SPLIT_REST_S at least."""
-        moves = np.concatenate([[0], np.flatnonzero(np.diff(self.x) != 0.0) + 1, [len(self.x)]])
-        a, b = moves[:-1], moves[1:]
-        long = self.t[b - 1] - self.t[a] >= SPLIT_REST_S
-        return list(zip(a[long].tolist(), b[long].tolist()))
-
     def split(self, fraction: float) -> tuple[Record, Record]:
         """(estimation, validation): the first part holds ``fraction`` of the record's motion
         (:meth:`motion`), the rest the remainder, so both parts move whatever the record does
-        (a log that moves early and then rests is not split in time); the cut in the middle of the rest
-        of the cart (:meth:`rests`) after the move it falls in, else before it, within SPLIT_REACH of that
-        share. ConfigError when the record hardly moves or a part would hold fewer than MIN_PART_COUNTS
-        of motion."""
+        (a log that moves early and then rests is not split in time). ConfigError when the record
+        hardly moves or a part would hold fewer than MIN_PART_COUNTS of motion."""
         moved = self.motion()
         total = float(moved[-1])
         k = int(np.searchsorted(moved, fraction * total))
-        near = [(a, b) for a, b in self.rests() if abs(moved[a] - fraction * total) <= SPLIT_REACH * total]
-        after = [(a, b) for a, b in near if b > k]
-        if near:
-            a, b = after[0] if after else near[-1]
-            k = (max(a, k) + b) // 2 if a <= k else (a + b) // 2
         k = min(max(k, MIN_SAMPLES // 2), len(self.t) - MIN_SAMPLES // 2)
         part_motion = (float(moved[k]), total - float(moved[k]))
         if min(part_motion) < MIN_PART_COUNTS:
