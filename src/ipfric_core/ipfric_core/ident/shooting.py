@@ -137,6 +137,8 @@ def make_windows(rec: Record, length_s: float, forced: bool = False, span: float
                 r = np.flatnonzero(rest[lo:end])
                 end = lo + int(r[-1]) + 1 if len(r) and end < b else end
             end = max(end, k + 2)          # a window holds two samples at least: the loop always advances
+            if t[b - 1] - t[end - 1] < 0.3 * length_s:
+                end = b                    # a tail too short for a window of its own is the last one's
             starts.append(k)
             stops.append(end)
             k = end - 1
