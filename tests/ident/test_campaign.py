@@ -350,8 +350,9 @@ def test_a_drive_in_place_of_a_mass_correction_reaches_its_play_with_the_law_fre
     The mass correction takes the motor side (M 1.94 kg against 1.38 declared) and bends the law beside it.
     The drive in place of it, short-fitted with the viscous slope and the Stribeck velocity held there, ended
     at 0.28-0.34 mm (the ladder then kept the correction); started from each of its plays and fitted with the
-    whole law, from 1 mm it reaches about 1 mm with the motor side's mass and the Coulomb level within 1 % of
-    the truth, and replays the estimation part 3.6 times closer than the correction."""
+    whole law, from 1 mm it stays near 1 mm (0.92 mm since the tails of the windows' stretches are judged:
+    e63d3af) with the motor side's mass and the Coulomb level within 1 % of the truth, and replays the
+    estimation part 10 times closer than the correction (3.6 before e63d3af)."""
     from ipfric_core.ident import hypotheses as hy
     from ipfric_core.ident.problem import Problem
     truth, drive, est, _, declared, corrected = mass_corrected_drive(tmp_path, 77)
@@ -360,7 +361,7 @@ def test_a_drive_in_place_of_a_mass_correction_reaches_its_play_with_the_law_fre
     h = hy.in_place_of_mass(pe, corrected, declared)
     assert sorted(s['drive_backlash_m'] for s in h.starts) == sorted({2 * est.x_resolution, *hy.IN_PLACE_GAPS})
     best, _ = hy.short_fit(pe, corrected, h, declared, pe.screen())
-    assert 0.5 * drive['gap_m'] < best['drive_backlash_m'] < 1.5 * drive['gap_m']
+    assert 0.4 * drive['gap_m'] < best['drive_backlash_m'] < 1.5 * drive['gap_m']
     assert best['drive_mass_kg'] == pytest.approx(drive['motor_mass_kg'], rel=0.02)
     assert best['Fc'] == pytest.approx(truth['friction']['Fc'], rel=0.05)
     assert pe.cost(best) < 0.25 * pe.cost(corrected)
