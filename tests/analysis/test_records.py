@@ -247,4 +247,3 @@ def test_an_angle_whose_equation_does_not_show_is_read_as_written_and_said_so(tm
     (tmp_path / 'flat.csv').write_text(table(theta=np.round(walk / 1.5e-3) * 1.5e-3 + 0.01))
     notes = ' '.join(load(tmp_path / 'flat.csv', None).notes)
     assert 'does not show where its angle is zero' in notes and 'nor can degrees or x and theta swapped' in notes
-
