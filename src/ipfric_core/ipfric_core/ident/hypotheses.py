@@ -432,9 +432,11 @@ def errors_of(pe: Problem, h: Hypothesis, model: Model, prior: Model, among=None
 
 def screen(hs: list[Hypothesis], short: list[tuple[Model, float]], pe: Problem, current: Model
            ) -> list[str | None]:
-    """Which hypotheses are fitted in full this round: per hypothesis None, or why not. An effect with the
-    friction levels free is measured by what it adds to the refit's short fit (the refit's gain it takes
-    for free); the others by their gain over ``current``. A short fit the data already contradict
+    """Which hypotheses are fitted in full this round: per hypothesis None, or why not. An effect or a
+    plant correction with the friction levels free is measured by what it adds to the refit's short fit (the
+    refit's gain it takes for free; :func:`beyond_refit` judges them so: measured over ``current``, a mass and
+    a motor factor each took a full fit on a 2-minute balancing loop whose cogging alone explained it, a
+    quarter of the identification's time); the others by their gain over ``current``. A short fit the data already contradict
     (:func:`contradictions`) is refused here and takes no place in its group. A hypothesis is fitted in
     full when its gain reaches SCREEN_GAIN and FULL_SHARE of the best of its group's, and it is among the
     FULL_TOP best of it. Fitted in full whenever they reach SCREEN_GAIN, outside the ranks: the refit of the
@@ -450,7 +452,7 @@ def screen(hs: list[Hypothesis], short: list[tuple[Model, float]], pe: Problem, 
     refuted = []
     forced = []
     for h, (m, g) in zip(hs, short):
-        levels = bool(h.levels) and h.kind == 'effect'
+        levels = bool(h.levels) and h.kind in ('effect', 'plant')
         gains.append((levels, 1.0 - pe.cost(m) / base if levels and base else g))
         why = contradictions(pe, m, h.effect) if h.effect and g >= SCREEN_GAIN else []
         refuted.append('its short fit: ' + '; '.join(why) if why else None)
