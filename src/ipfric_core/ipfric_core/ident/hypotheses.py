@@ -432,19 +432,21 @@ def errors_of(pe: Problem, h: Hypothesis, model: Model, prior: Model, among=None
 
 def screen(hs: list[Hypothesis], short: list[tuple[Model, float]], pe: Problem, current: Model
            ) -> list[str | None]:
-    """Which hypotheses are fitted in full this round: per hypothesis None, or why not. An effect or a
-    plant correction with the friction levels free is measured by what it adds to the refit's short fit (the
-    refit's gain it takes for free; :func:`beyond_refit` judges them so: measured over ``current``, a mass and
-    a motor factor each took a full fit on a 2-minute balancing loop whose cogging alone explained it, a
-    quarter of the identification's time); the others by their gain over ``current``. A short fit the data already contradict
-    (:func:`contradictions`) is refused here and takes no place in its group. A hypothesis is fitted in
-    full when its gain reaches SCREEN_GAIN and FULL_SHARE of the best of its group's, and it is among the
-    FULL_TOP best of it. Fitted in full whenever they reach SCREEN_GAIN, outside the ranks: the refit of the
-    declared law (the hypotheses that carry it must beat it: :func:`beyond_refit`; screened out by rank, it
-    left a balancing loop with nothing kept where it alone explained 37 % of the validation error), and the
-    leaner laws where the refit's short fit ends on a bound (the declared law is refuted there, and a law
-    with more parts ends on the same bound: a cart logged at 30 ms whose refit lost its Coulomb level kept
-    nothing, the viscous law ranked fourth)."""
+    """Which hypotheses are fitted in full this round: per hypothesis None, or why not. An effect or a plant correction
+    with the friction levels free is measured by what it adds to the refit's short fit (the refit's gain it takes
+    for free; :func:`beyond_refit` judges them so); the others by their gain over ``current``. A short fit the data
+    already contradict (:func:`contradictions`) is refused here and takes no place in its group. A hypothesis is
+    fitted in full when its gain reaches SCREEN_GAIN and FULL_SHARE of the best of its group's, and it is among the
+    FULL_TOP best of it. The plant corrections (two at most) take no place in the ranks and do not set the bar: each
+    is fitted in full when its gain beyond the refit reaches FULL_SHARE of the best effect's. Measured over
+    ``current``, a mass and a motor factor each took a full fit on a 2-minute balancing loop whose cogging alone
+    explained it (a quarter of the identification's time); ranked among the effects, a real cart's motor factor lost
+    its full fit to three effects, and a mass correction's bar kept a real cart's amplifier clipping from its full
+    fit. Fitted in full whenever they reach SCREEN_GAIN, outside the ranks: the refit of the declared law (the
+    hypotheses that carry it must beat it: :func:`beyond_refit`; screened out by rank, it left a balancing loop with
+    nothing kept where it alone explained 37 % of the validation error), and the leaner laws where the refit's short
+    fit ends on a bound (the declared law is refuted there, and a law with more parts ends on the same bound: a cart
+    logged at 30 ms whose refit lost its Coulomb level kept nothing, the viscous law ranked fourth)."""
     refit = next((m for h, (m, _) in zip(hs, short) if h.kind == 'friction'), None)
     base = pe.cost(refit) if refit is not None else None
     refuted_law = refit is not None and any(p.name in LAW_PARAMS[refit.law] for p in bound_params(refit))
@@ -458,11 +460,12 @@ def screen(hs: list[Hypothesis], short: list[tuple[Model, float]], pe: Problem, 
         refuted.append('its short fit: ' + '; '.join(why) if why else None)
         leaner = h.kind == 'law' and len(h.own) < len(LAW_PARAMS[current.law])
         forced.append(g >= SCREEN_GAIN and (h.kind == 'friction' or (leaner and refuted_law)))
-    alive = [(lv, g) for (lv, g), r, f in zip(gains, refuted, forced) if r is None and not f]
+    plant = [h.kind == 'plant' for h in hs]
+    alive = [(lv, g) for (lv, g), r, f, pl in zip(gains, refuted, forced, plant) if r is None and not f and not pl]
     top = {grp: max([g for lv, g in alive if lv == grp], default=0.0) for grp in (True, False)}
     rank = {grp: sorted((g for lv, g in alive if lv == grp), reverse=True) for grp in (True, False)}
     out: list[str | None] = []
-    for (lv, g), r, f in zip(gains, refuted, forced):
+    for (lv, g), r, f, pl in zip(gains, refuted, forced, plant):
         what = 'beyond the refit\'s' if lv else 'over the model\'s'
         if r is not None:
             out.append(r)
@@ -474,7 +477,7 @@ def screen(hs: list[Hypothesis], short: list[tuple[Model, float]], pe: Problem, 
             out.append(f'its short fit lowers the estimation error by {100 * g:.2g} % {what}, less than '
                        f'{100 * FULL_SHARE:g} % of the best one\'s {100 * top[lv]:.2g} %: not fitted in full '
                        f'this round')
-        elif rank[lv].index(g) >= FULL_TOP:
+        elif not pl and rank[lv].index(g) >= FULL_TOP:
             out.append(f'its short fit lowers the estimation error by {100 * g:.2g} % {what}: not among the '
                        f'{FULL_TOP} best of its group, not fitted in full this round')
         else:
