@@ -1,0 +1,74 @@
+"""Which hypotheses of a round are fitted in full (``hypotheses.screen``): a plant correction that refits the
+friction levels is measured, as it is judged, by what it adds to the refit's short fit; the two plant
+corrections take no place in the effects' ranks and do not set their bar."""
+import pytest
+
+from ipfric_core.ident.effects import EFFECTS
+from ipfric_core.ident.hypotheses import FULL_SHARE, FULL_TOP, Hypothesis, screen
+from ipfric_core.ident.model import LAW_PARAMS, load_declared
+
+DECLARED = load_declared(None, 'exponential', False)
+LAW = LAW_PARAMS['exponential']
+
+
+class Costs:
+    """The estimation costs of the short-fitted models, by model (what ``screen`` asks of its problem)."""
+
+    def __init__(self, costs: dict):
+        self.costs = costs
+
+    def cost(self, model) -> float:
+        return self.costs[id(model)]
+
+
+def round_of(plant_gains: dict, effect_gains: dict) -> dict:
+    """The screen's notes by label for a round of the refit (estimation cost 1), the plant corrections and
+    the effects (each with the levels refitted) whose short fits lower that cost by the given shares. The
+    short fits' gains over the declared model are all 0.95: what a correction fitted with the levels takes
+    from the refit for free."""
+    refit = Hypothesis('refit', 'friction', DECLARED.with_free(LAW), LAW, LAW)
+    hs = [refit]
+    costs = {id(refit.model): 1.0}
+    for name, gain in plant_gains.items():
+        h = Hypothesis(f'{name} corrected', 'plant', DECLARED.with_free((name,) + LAW), (name,), (name,) + LAW)
+        hs.append(h)
+        costs[id(h.model)] = 1.0 - gain
+    for name, gain in effect_gains.items():
+        own = EFFECTS[name].params
+        h = Hypothesis(name, 'effect', DECLARED.with_effect(name).with_free(own + LAW), own, own + LAW,
+                       effect=name)
+        hs.append(h)
+        costs[id(h.model)] = 1.0 - gain
+    # gains over the declared model below the screen's threshold for the effects: no short fit is checked
+    # against the data (there are none here); the plant corrections' 0.95 is what the old screen ranked
+    short = [(h.model, 0.95 if h.kind != 'effect' else 0.0) for h in hs]
+    return dict(zip((h.label for h in hs), screen(hs, short, Costs(costs), DECLARED)))
+
+
+def test_a_plant_correction_far_below_the_best_effect_beyond_the_refit_is_not_fitted_in_full():
+    """A balancing loop whose cogging explains it: the mass and the motor factor take the refit's gain with
+    them (95 % over the declared model) but add 11-12 % to it, against the cogging's 98 %."""
+    notes = round_of({'M': 0.11, 'alpha': 0.12}, {'cogging': 0.98})
+    assert notes['refit'] is None and notes['cogging'] is None
+    for name in ('M corrected', 'alpha corrected'):
+        assert f'less than {100 * FULL_SHARE:g} % of the best one\'s 98 %' in notes[name], notes
+
+
+def test_a_plant_correction_is_fitted_in_full_outside_the_effects_ranks():
+    """Four effects add more than the motor factor, which still adds more than half the best one's: it is
+    fitted in full (no effect loses its place to it); the mass, below half, is not; the fourth effect is
+    ranked out as before."""
+    effects = {'cogging': 0.98, 'lag': 0.92, 'offset': 0.75, 'asymmetry': 0.71}
+    notes = round_of({'M': 0.28, 'alpha': 0.64}, effects)
+    assert notes['alpha corrected'] is None, notes
+    assert 'less than' in notes['M corrected']
+    assert [notes[e] for e in list(effects)[:FULL_TOP]] == [None] * FULL_TOP
+    assert f'not among the {FULL_TOP} best' in notes['asymmetry']
+
+
+@pytest.mark.parametrize('plant_gain', [0.30, 0.95])
+def test_a_plant_correction_does_not_set_the_effects_bar(plant_gain):
+    """An amplifier clipping that adds 11 % beyond the refit where the best effect adds 20 % is fitted in full
+    whatever a mass correction adds."""
+    notes = round_of({'M': plant_gain}, {'offset': 0.20, 'saturation': 0.11})
+    assert notes['saturation'] is None and notes['offset'] is None and notes['M corrected'] is None, notes
