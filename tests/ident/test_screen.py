@@ -51,7 +51,7 @@ def test_a_plant_correction_far_below_the_best_effect_beyond_the_refit_is_not_fi
     notes = round_of({'M': 0.11, 'alpha': 0.12}, {'cogging': 0.98})
     assert notes['refit'] is None and notes['cogging'] is None
     for name in ('M corrected', 'alpha corrected'):
-        assert f'less than {100 * FULL_SHARE:g} % of the best one\'s 98 %' in notes[name], notes
+        assert f'less than {100 * FULL_SHARE:g} % of the best effect\'s 98 %' in notes[name], notes
 
 
 def test_a_plant_correction_is_fitted_in_full_outside_the_effects_ranks():

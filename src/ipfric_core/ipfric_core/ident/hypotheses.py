@@ -474,8 +474,9 @@ def screen(hs: list[Hypothesis], short: list[tuple[Model, float]], pe: Problem, 
         elif g < SCREEN_GAIN:
             out.append(f'its short fit lowers the estimation error by {100 * g:.2g} % {what} only')
         elif g < FULL_SHARE * top[lv]:
+            best = 'effect' if pl else 'one'
             out.append(f'its short fit lowers the estimation error by {100 * g:.2g} % {what}, less than '
-                       f'{100 * FULL_SHARE:g} % of the best one\'s {100 * top[lv]:.2g} %: not fitted in full '
+                       f'{100 * FULL_SHARE:g} % of the best {best}\'s {100 * top[lv]:.2g} %: not fitted in full '
                        f'this round')
         elif not pl and rank[lv].index(g) >= FULL_TOP:
             out.append(f'its short fit lowers the estimation error by {100 * g:.2g} % {what}: not among the '
