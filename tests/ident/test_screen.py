@@ -4,7 +4,7 @@ corrections take no place in the effects' ranks and do not set their bar."""
 import pytest
 
 from ipfric_core.ident.effects import EFFECTS
-from ipfric_core.ident.hypotheses import FULL_TOP, PLANT_SHARE, Hypothesis, screen
+from ipfric_core.ident.hypotheses import FULL_SHARE, FULL_TOP, Hypothesis, screen
 from ipfric_core.ident.model import LAW_PARAMS, load_declared
 
 DECLARED = load_declared(None, 'exponential', False)
@@ -51,15 +51,15 @@ def test_a_plant_correction_far_below_the_best_effect_beyond_the_refit_is_not_fi
     notes = round_of({'M': 0.11, 'alpha': 0.12}, {'cogging': 0.98})
     assert notes['refit'] is None and notes['cogging'] is None
     for name in ('M corrected', 'alpha corrected'):
-        assert f'less than {100 * PLANT_SHARE:g} % of the best effect\'s 98 %' in notes[name], notes
+        assert f'less than {100 * FULL_SHARE:g} % of the best effect\'s 98 %' in notes[name], notes
 
 
 def test_a_plant_correction_is_fitted_in_full_outside_the_effects_ranks():
-    """Four effects add more than the motor factor, which still adds a quarter of the best one's: it is
-    fitted in full (no effect loses its place to it); the mass, below PLANT_SHARE of it, is not; the fourth
-    effect is ranked out as before."""
+    """Four effects add more than the motor factor, which still adds more than half the best one's: it is
+    fitted in full (no effect loses its place to it); the mass, below half, is not; the fourth effect is
+    ranked out as before."""
     effects = {'cogging': 0.98, 'lag': 0.92, 'offset': 0.75, 'asymmetry': 0.71}
-    notes = round_of({'M': 0.20, 'alpha': 0.30}, effects)
+    notes = round_of({'M': 0.28, 'alpha': 0.64}, effects)
     assert notes['alpha corrected'] is None, notes
     assert 'less than' in notes['M corrected']
     assert [notes[e] for e in list(effects)[:FULL_TOP]] == [None] * FULL_TOP

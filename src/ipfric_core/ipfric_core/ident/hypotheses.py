@@ -49,10 +49,6 @@ SCREEN_GAIN = 0.01       # an effect whose own parameters lower the estimation c
 GRID_SCREENED = ('drive_backlash',)
 FULL_SHARE = 0.5         # a candidate is fitted in full when its short fit gains this share of the best one's
 FULL_TOP = 3             # and is among the best FULL_TOP of its group
-#: a plant correction (outside the ranks) is fitted in full when it adds this share of the best effect's gain
-#: beyond the refit: a real cart's mass correction whose short fit added 18 % to the refit's, against an
-#: effect's 49 %, took the validation error from 18.5 % of the motion to 14.4 % once fitted in full
-PLANT_SHARE = 0.25
 REDO_GAIN = 0.1          # a short fit that gains this much on a subset of windows and nothing on all is redone on all
 #: and one that leaves every window this much worse than the model it starts from (its friction levels
 #: wandered off on the subset)
@@ -442,7 +438,7 @@ def screen(hs: list[Hypothesis], short: list[tuple[Model, float]], pe: Problem, 
     already contradict (:func:`contradictions`) is refused here and takes no place in its group. A hypothesis is
     fitted in full when its gain reaches SCREEN_GAIN and FULL_SHARE of the best of its group's, and it is among the
     FULL_TOP best of it. The plant corrections (two at most) take no place in the ranks and do not set the bar: each
-    is fitted in full when its gain beyond the refit reaches PLANT_SHARE of the best effect's. Measured over
+    is fitted in full when its gain beyond the refit reaches FULL_SHARE of the best effect's. Measured over
     ``current``, a mass and a motor factor each took a full fit on a 2-minute balancing loop whose cogging alone
     explained it (a quarter of the identification's time); ranked among the effects, a real cart's motor factor lost
     its full fit to three effects, and a mass correction's bar kept a real cart's amplifier clipping from its full
@@ -477,11 +473,11 @@ def screen(hs: list[Hypothesis], short: list[tuple[Model, float]], pe: Problem, 
             out.append(None)
         elif g < SCREEN_GAIN:
             out.append(f'its short fit lowers the estimation error by {100 * g:.2g} % {what} only')
-        elif g < (PLANT_SHARE if pl else FULL_SHARE) * top[lv]:
+        elif g < FULL_SHARE * top[lv]:
             best = 'effect' if pl else 'one'
             out.append(f'its short fit lowers the estimation error by {100 * g:.2g} % {what}, less than '
-                       f'{100 * (PLANT_SHARE if pl else FULL_SHARE):g} % of the best {best}\'s {100 * top[lv]:.2g} %: '
-                       f'not fitted in full this round')
+                       f'{100 * FULL_SHARE:g} % of the best {best}\'s {100 * top[lv]:.2g} %: not fitted in full '
+                       f'this round')
         elif not pl and rank[lv].index(g) >= FULL_TOP:
             out.append(f'its short fit lowers the estimation error by {100 * g:.2g} % {what}: not among the '
                        f'{FULL_TOP} best of its group, not fitted in full this round')
