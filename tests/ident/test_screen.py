@@ -40,7 +40,8 @@ def round_of(plant_gains: dict, effect_gains: dict) -> dict:
         hs.append(h)
         costs[id(h.model)] = 1.0 - gain
     # gains over the declared model below the screen's threshold for the effects: no short fit is checked
-    # against the data (there are none here); the plant corrections' 0.95 is what the old screen ranked
+    # against the data (there are none here); the plant corrections' 0.95 carries the refit's gain, which
+    # the screen must not count for them
     short = [(h.model, 0.95 if h.kind != 'effect' else 0.0) for h in hs]
     return dict(zip((h.label for h in hs), screen(hs, short, Costs(costs), DECLARED)))
 
