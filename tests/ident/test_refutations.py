@@ -1,5 +1,6 @@
 """What refutes a fitted model besides its error (ident/refutations.py), on records of the independent
-simulator (tests/independent/rigsim.py): a static friction that no command of the record overcomes."""
+simulator (tests/independent/rigsim.py): a static friction that no command of the record overcomes, no static
+friction where the cart stood still under force."""
 from dataclasses import replace
 
 import numpy as np
@@ -8,7 +9,17 @@ from independent import rigsim
 
 from ipfric_core.analysis.records import load
 from ipfric_core.ident.model import load_declared
-from ipfric_core.ident.refutations import crossings, never_starts, reversals, stops_and_starts, unseen
+from ipfric_core.ident.refutations import (
+    HOLD_COUNTS,
+    crossings,
+    never_holds,
+    never_starts,
+    reversals,
+    stops,
+    stops_and_starts,
+    unheld_travel,
+    unseen,
+)
 
 
 def test_a_static_friction_no_command_overcomes_refutes_the_model(tmp_path):
@@ -164,3 +175,29 @@ def test_an_encoder_play_is_at_most_what_the_cart_crosses_while_its_readings_tur
     assert contradictions(pr, model.with_values({'backlash_m': play_counts * q}), 'backlash') == []
     why = contradictions(pr, model.with_values({'backlash_m': 1.01 * limit}), 'backlash')
     assert len(why) == 1 and f'within {turn * 1e3:.3g} ms' in why[0] and f'{fastest:.3g} m/s' in why[0], why
+
+
+@pytest.mark.parametrize('case, duration', [('cart_none', 20.0), ('loop_none', 30.0)])
+def test_no_static_friction_where_the_cart_stood_still_under_force_refutes_the_viscous_law(tmp_path, case, duration):
+    """A rig with Coulomb friction (the independent simulator's) stands still under commands a cart without
+    static friction would have followed, on the cart alone and in a balancing loop: the viscous law is refuted
+    at those stops; the same rig without Coulomb friction (mu_c = mu_s = 0) stops only
+    where nothing pushes it, and the law stands. The laws that stick are not judged so."""
+    spec = rigsim.CASES[case]
+    pendulum = spec['experiment'] == 'loop'
+    model = load_declared(None, 'viscous', pendulum=pendulum)
+    rec = load(rigsim.write_case(case, tmp_path, duration=duration), None)
+    moved = [unheld_travel(rec, model, a, b) / rec.x_resolution for a, b in stops(rec)]
+    beyond = sum(m >= HOLD_COUNTS for m in moved)
+    assert beyond >= 3, moved
+    why = never_holds([rec], model)
+    assert len(why) == 1 and f'stood still at {beyond} of {len(moved)} stops' in why[0], why
+    assert f'{max(moved):.3g} encoder counts' in why[0]
+    assert never_holds([rec], load_declared(None, 'exponential', pendulum=pendulum)) == []
+    assert never_holds([rec], model.with_effect('drive_backlash', {'drive_backlash_m': 1e-3})) == []
+    smooth = rigsim.simulate(dict(spec, rig_overrides={'mu_c': 0.0, 'mu_s': 0.0}), duration)
+    smooth['truth']['case'] = case
+    rec = load(rigsim.write_case(case, tmp_path / 'viscous', data=smooth), None)
+    assert len(stops(rec)) >= 3
+    assert max(unheld_travel(rec, model, a, b) for a, b in stops(rec)) < rec.x_resolution
+    assert never_holds([rec], model) == []

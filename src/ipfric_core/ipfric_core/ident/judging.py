@@ -80,7 +80,7 @@ def judge(pe: Problem, pv: Problem, current: Model, h: Hypothesis, m: Model, not
     ev1 = pv.cost(m)
     ee0, ee1 = pe.cost(current), pe.cost(m)
     gain, pval, dropped = drop_checks(pv, current, m, sse0_v)
-    why = ([note] if note else []) + unfit(pe.rec, m)
+    why = ([note] if note else []) + unfit(pe.rec, m, val=pv.rec)
     if h.effect and not (note or '').startswith('its short fit: '):
         why += contradictions(pe, m, h.effect)
     why += dropped

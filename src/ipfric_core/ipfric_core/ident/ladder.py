@@ -241,7 +241,7 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
         law = LAW_PARAMS[declared.law]
         fitted, s = fit_model(pe, declared.with_free(law), prior=declared)
         names = ', '.join(p.name for p in declared.free)
-        refuted = unfit(pe.rec, fitted, s)
+        refuted = unfit(pe.rec, fitted, s, pv.rec)
         if refuted:
             steps[0].notes.append(f'the refit of the {declared.law} law with {names} (--free) is refuted: '
                                   + '; '.join(refuted) + '; the rounds start from the declared values, '
@@ -300,7 +300,7 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
         win = ok[0]
         before = current
         current, s = fit_model(pe, win.model, max_nfev=60, prior=declared)   # every fitted parameter together
-        if unfit(pe.rec, current, s) or pv.cost(current) > pv.cost(win.model):
+        if unfit(pe.rec, current, s, pv.rec) or pv.cost(current) > pv.cost(win.model):
             current, s = win.model, win.std
         label = {'friction': 'refit', 'law': win.h.label, 'plant': win.h.label}.get(win.h.kind, f'+ {win.h.effect}')
         corrected = win.h.kind == 'plant' or (current.viscous_in_beta and not before.viscous_in_beta)
@@ -309,7 +309,8 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
         step_notes += held_notes(win.h, current) + win.notes
         if win.h.kind == 'law' and 'Fc' not in LAW_PARAMS[current.law]:
             step_notes.append('the viscous law has no Coulomb level: a real cart slides against one, and these data '
-                              'do not show it; not a final model of a real cart (the verdict says what is left)')
+                              'do not show it (no stop where the cart stood still against a force it would have '
+                              'followed); not a final model of a real cart (the verdict says what is left)')
         step_notes += [f'{p.name} held at {p.value:.4g} {p.unit} (damping ratio {DRIVE_GRID[3]:g}): the fit put it '
                        'on a bound, the data do not determine it' for p in current.params
                        if p.name == 'drive_damping_Ns_per_m' and not p.free]
@@ -340,7 +341,7 @@ def take_back(pe: Problem, pv: Problem, declared: Model, current: Model, candida
     (:func:`undo_corrections`, :func:`drop_spent`)."""
     m, s = fit_model(pe, candidate, prior=declared)
     before, after = pv.summary(current)['x_rms_counts'], pv.summary(m)['x_rms_counts']
-    if after > before * (1 + WORSE_PERCENT / 100) or unfit(pe.rec, m):
+    if after > before * (1 + WORSE_PERCENT / 100) or unfit(pe.rec, m, val=pv.rec):
         return current
     note += f' (validation error {after:.3g} counts, {before:.3g} before; within {WORSE_PERCENT:g} %)'
     steps.append(Step(label, m, s, pe.summary(m), pv.summary(m), [note]))

@@ -11,24 +11,25 @@ import numpy as np
 
 from ..analysis.records import Record, smooth_rate
 from ..physics.friction import holding_margin, static_limit, sticks
-from ..physics.rig import input_effects
+from ..physics.plant import undeclared_force
+from ..physics.rig import drive_means, input_effects
 from . import shooting
 from .effects import PARAMS, static_level
 from .model import Model
 from .problem import Problem
 
-__all__ = ['SIZE', 'RIPPLE_PERIODS', 'valid_moves', 'stops_and_starts', 'smallest_moving_command', 'steady_speeds',
-           'response_lag',
-           'crossings', 'unseen', 'drive_crossings', 'widest_play',
+__all__ = ['SIZE', 'RIPPLE_PERIODS', 'valid_moves', 'stops', 'stops_and_starts', 'smallest_moving_command',
+           'steady_speeds', 'response_lag', 'crossings', 'unseen', 'drive_crossings', 'widest_play',
            'contradictions', 'unresolved', 'near', 'uncorrected', 'rest_offset', 'no_static_level', 'bound_params',
-           'on_bounds', 'untold', 'reversals', 'never_starts', 'unfit', 'smallest_play', 'CLOSED_PLAY', 'play_closed',
-           'size_params']
+           'on_bounds', 'untold', 'reversals', 'never_starts', 'unheld_travel', 'never_holds', 'unfit',
+           'smallest_play', 'CLOSED_PLAY', 'play_closed', 'size_params']
 
 PLAY_COUNTS = 2.0        # a play (the encoder's or a drive's) below this many encoder counts is quantization
 CLOSED_PLAY = 1e-9       # a drive's play closed [m]: a compliant contact without play (0 takes the drive away)
 UNDO_SIGMA = 2.0         # a correction that ends this many standard errors from the declared value or closer is undone
 STOP_S = 0.05            # a stretch this long with the encoder still is a stop [s]
 BREAKAWAY_S = 0.5        # a cart that starts from rest travels three counts within this long [s]
+HOLD_COUNTS = 3.0        # a stop a law without static friction leaves by this many encoder counts refutes it
 #: a cogging repeats at least this often over the travel: once repeated, a force is a ripple (a balancing loop's
 #: cart travels 31 mm: a 14 mm cogging of 2.5 counts, fitted at 13.6 mm, was refused at three)
 RIPPLE_PERIODS = 2.0
@@ -47,16 +48,18 @@ def valid_moves(rec: Record) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.nda
     return keep, x, t, np.flatnonzero(np.diff(x) != 0.0)
 
 
-def stops_and_starts(rec: Record) -> list[tuple[int, int]]:
-    """(last still sample, first moving sample) of every breakaway after a stop of STOP_S, read on the
-    valid readings (:func:`valid_moves`: a cart frozen by overruns for 60 ms of a 10 ms loop has not
-    stopped)."""
+def stops(rec: Record) -> list[tuple[int, int]]:
+    """(first, last) sample of every stop: a stretch of STOP_S or longer between two moves of the cart
+    over which the encoder stands still, read on the valid readings (:func:`valid_moves`: a cart frozen by
+    overruns for 60 ms of a 10 ms loop has not stopped)."""
     keep, x, t, moves = valid_moves(rec)
-    out = []
-    for a, b in zip(moves[:-1], moves[1:]):
-        if t[b] - t[a + 1] >= STOP_S:
-            out.append((int(keep[b]), int(keep[b + 1])))
-    return out
+    return [(int(keep[a + 1]), int(keep[b])) for a, b in zip(moves[:-1], moves[1:]) if t[b] - t[a + 1] >= STOP_S]
+
+
+def stops_and_starts(rec: Record) -> list[tuple[int, int]]:
+    """(last still sample, first moving sample) of every breakaway after a stop (:func:`stops`)."""
+    keep = np.flatnonzero(rec.valid_mask)
+    return [(last, int(keep[np.searchsorted(keep, last) + 1])) for _, last in stops(rec)]
 
 
 def smallest_moving_command(rec: Record) -> float | None:
@@ -374,8 +377,69 @@ def never_starts(rec: Record, model: Model) -> list[str]:
     return []
 
 
-def unfit(rec: Record, model: Model, std: dict | None = None) -> list[str]:
+def unheld_travel(rec: Record, model: Model, first: int, last: int) -> float:
+    """How far [m] a cart without static friction must leave the one encoder count it stood still in over
+    the stop ``first`` .. ``last`` (sample indices, :func:`stops`), at the least: ``model``'s drive force
+    (alpha times the command through its delay, lag, deadzone and saturation, eq. 2) and its track force
+    (offset, cogging at the stop's reading) integrated twice from the stop's start, with the pendulum's
+    reaction (paper eq. 1: (M + m) x'' + m l (theta' cos(theta))' = F, so m l (sin(theta) - sin(theta_0))
+    after two integrals), against every start speed (a line in time, which takes theta_0' too); within the
+    stop the cart moves less than a count (plus an encoder play) w, so the viscous term (beta + eps) x'
+    gives at most (beta + eps) w t, and that much is allowed, as is the angle's rounding. 0 where the stop
+    is consistent with no static friction at all."""
+    from scipy.optimize import linprog
+    tr = model.vectors().truth
+    idx = np.arange(first, last + 1)
+    t = rec.t[idx] - rec.t[first]
+    volts = drive_means(rec.t, rec.u, tr.input_delay_s, tr.input_lag_s)[idx]
+    cart = rec.x[first]
+    track = undeclared_force(tr.force_vector(), cart, 0.0)
+    force = np.array([model['alpha'] * input_effects(v, tr.deadzone_V, tr.saturation_V) for v in volts]) + track
+    h = np.diff(t)
+    impulse = np.concatenate([[0.0], np.cumsum(force[:-1] * h)])
+    travel = np.concatenate([[0.0], np.cumsum(impulse[:-1] * h + 0.5 * force[:-1] * h ** 2)])
+    mass, swing = model['M'], 0.0
+    if rec.theta is not None and model.pendulum:
+        mass += model['m']
+        travel -= model['m'] * model['l'] * (np.sin(rec.theta[idx]) - math.sin(rec.theta[first]))
+        swing = model['m'] * model['l'] * rec.theta_resolution      # the angle's rounding, twice half a count
+    valid = rec.valid_mask[idx]
+    g, tv = travel[valid] / mass, t[valid]
+    w = rec.x_resolution + model.get('backlash_m')
+    slack = (model['beta'] + model['eps']) * w * tv / mass
+    # min over the start speed a of max_k |g_k - a t_k| - slack_k: a linear programme in (a, e)
+    ones = np.ones_like(tv)
+    res = linprog([0.0, 1.0], A_ub=np.vstack([np.column_stack([-tv, -ones]), np.column_stack([tv, -ones])]),
+                  b_ub=np.concatenate([slack - g, slack + g]), bounds=[(None, None), (None, None)], method='highs')
+    return max(float(res.x[1]) - w - swing / mass, 0.0) if res.success else 0.0
+
+
+def never_holds(recs, model: Model) -> list[str]:
+    """Why ``model``'s cart could not stand still where the records' did (``recs``: the estimation and the
+    validation parts; a stop is what the data show, in either): a law without static friction (the viscous
+    law) moves the cart under any force, and the records show stops (:func:`stops`) over which the forces of
+    the drive, the track and the pendulum would have moved it beyond HOLD_COUNTS encoder counts
+    (:func:`unheld_travel`; the ESP32 cart's log at 0.1 Hz stood still for 0.11 s under commands of up to 4.6
+    V, where a cart without static friction leaves its count by 13 counts). Not judged with a drive play (its
+    motor side takes the force across the play while the cart stands)."""
+    if model.law != 'viscous' or 'drive_backlash' in model.effects:
+        return []
+    moved = [(unheld_travel(rec, model, a, b) / rec.x_resolution, rec.t[a], rec.t[b] - rec.t[a])
+             for rec in recs for a, b in stops(rec)]
+    beyond = [m for m in moved if m[0] >= HOLD_COUNTS]
+    if not beyond:
+        return []
+    counts, start, still = max(beyond)
+    return [f'the viscous law has no static friction, yet the cart stood still at {len(beyond)} of {len(moved)} '
+            f'stops where the drive\'s force would have moved it (at t = {start:.4g} s for {still:.3g} s: '
+            f'{counts:.3g} encoder counts beyond its count at the least)']
+
+
+def unfit(rec: Record, model: Model, std: dict | None = None, val: Record | None = None) -> list[str]:
     """Why a fitted ``model`` cannot stand as a step, whatever its error: a parameter on its bound
     (:func:`on_bounds`), a Coulomb level not told from zero by its standard errors ``std`` (:func:`untold`;
-    not checked without them) and a static friction that never lets the cart start (:func:`never_starts`)."""
-    return on_bounds(model) + (untold(model, std) if std else []) + never_starts(rec, model)
+    not checked without them), a static friction that never lets the cart start in the estimation part
+    ``rec`` (:func:`never_starts`) and no static friction where the cart stood still under force in it or in
+    the validation part ``val`` (:func:`never_holds`)."""
+    return (on_bounds(model) + (untold(model, std) if std else []) + never_starts(rec, model)
+            + never_holds([rec] + ([val] if val is not None else []), model))
