@@ -53,6 +53,9 @@ def row(rig: str, log: str, run: dict, result: dict | None) -> dict:
     if result is None:
         return dict(out, kept='-', verdict=f'refused: {run.get("error", "no result.json")}', friction='-', bound='-')
     kept = [r['kept'] for r in result['rounds'] if r['kept']]
+    for s in result['ladder']:
+        if s['step'].startswith('- ') and s['step'][2:] in kept:      # an effect the ladder took back
+            kept.remove(s['step'][2:])
     kept += [s['step'] for s in result['ladder'] if s['step'].endswith(' as declared')]
     kept += [f'{n} corrected' for n in result.get('constants_corrected', []) if f'{n} corrected' not in kept]
     v = result['verdict']
