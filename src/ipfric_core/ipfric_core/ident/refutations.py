@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.optimize import linprog
 
 from ..analysis.records import Record, smooth_rate
 from ..physics.friction import holding_margin, static_limit, sticks
@@ -382,12 +383,11 @@ def unheld_travel(rec: Record, model: Model, first: int, last: int) -> float:
     the stop ``first`` .. ``last`` (sample indices, :func:`stops`), at the least: ``model``'s drive force
     (alpha times the command through its delay, lag, deadzone and saturation, eq. 2) and its track force
     (offset, cogging at the stop's reading) integrated twice from the stop's start, with the pendulum's
-    reaction (paper eq. 1: (M + m) x'' + m l (theta' cos(theta))' = F, so m l (sin(theta) - sin(theta_0))
-    after two integrals), against every start speed (a line in time, which takes theta_0' too); within the
-    stop the cart moves less than a count (plus an encoder play) w, so the viscous term (beta + eps) x'
-    gives at most (beta + eps) w t, and that much is allowed, as is the angle's rounding. 0 where the stop
-    is consistent with no static friction at all."""
-    from scipy.optimize import linprog
+    reaction (the cart's equation of paper eqs. 1-2: (M + m) x'' + m l (theta' cos(theta))' = F, so m l
+    (sin(theta) - sin(theta_0)) after two integrals), against every start speed (a line in time, which takes
+    theta_0' too); within the stop the cart moves less than a count (plus an encoder play) w, so the viscous
+    term (beta + eps) x' gives at most (beta + eps) w t, and that much is allowed, as is the angle's
+    rounding. 0 where the stop is consistent with no static friction at all."""
     tr = model.vectors().truth
     idx = np.arange(first, last + 1)
     t = rec.t[idx] - rec.t[first]
