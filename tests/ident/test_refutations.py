@@ -17,7 +17,7 @@ from ipfric_core.ident.refutations import (
     reversals,
     stops,
     stops_and_starts,
-    unheld_travel,
+    unheld_travels,
     unseen,
 )
 
@@ -187,7 +187,7 @@ def test_no_static_friction_where_the_cart_stood_still_under_force_refutes_the_v
     pendulum = spec['experiment'] == 'loop'
     model = load_declared(None, 'viscous', pendulum=pendulum)
     rec = load(rigsim.write_case(case, tmp_path, duration=duration), None)
-    moved = [unheld_travel(rec, model, a, b) / rec.x_resolution for a, b in stops(rec)]
+    moved = [travel / rec.x_resolution for travel, _, _ in unheld_travels(rec, model)]
     beyond = sum(m >= HOLD_COUNTS for m in moved)
     assert beyond >= 3, moved
     why = never_holds([rec], model)
@@ -199,5 +199,5 @@ def test_no_static_friction_where_the_cart_stood_still_under_force_refutes_the_v
     smooth['truth']['case'] = case
     rec = load(rigsim.write_case(case, tmp_path / 'viscous', data=smooth), None)
     assert len(stops(rec)) >= 3
-    assert max(unheld_travel(rec, model, a, b) for a, b in stops(rec)) < rec.x_resolution
+    assert max(travel for travel, _, _ in unheld_travels(rec, model)) < rec.x_resolution
     assert never_holds([rec], model) == []

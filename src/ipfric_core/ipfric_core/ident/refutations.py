@@ -22,7 +22,7 @@ from .problem import Problem
 __all__ = ['SIZE', 'RIPPLE_PERIODS', 'valid_moves', 'stops', 'stops_and_starts', 'smallest_moving_command',
            'steady_speeds', 'response_lag', 'crossings', 'unseen', 'drive_crossings', 'widest_play',
            'contradictions', 'unresolved', 'near', 'uncorrected', 'rest_offset', 'no_static_level', 'bound_params',
-           'on_bounds', 'untold', 'reversals', 'never_starts', 'unheld_travel', 'never_holds', 'unfit',
+           'on_bounds', 'untold', 'reversals', 'never_starts', 'unheld_travels', 'never_holds', 'unfit',
            'smallest_play', 'CLOSED_PLAY', 'play_closed', 'size_params']
 
 PLAY_COUNTS = 2.0        # a play (the encoder's or a drive's) below this many encoder counts is quantization
@@ -378,10 +378,10 @@ def never_starts(rec: Record, model: Model) -> list[str]:
     return []
 
 
-def unheld_travel(rec: Record, model: Model, first: int, last: int) -> float:
+def unheld_travels(rec: Record, model: Model) -> list[tuple[float, int, int]]:
     """How far [m] a cart without static friction must leave the one encoder count it stood still in over
-    the stop ``first`` .. ``last`` (sample indices, :func:`stops`), at the least: ``model``'s drive force
-    (alpha times the command through its delay, lag, deadzone and saturation, eq. 2) and its track force
+    each stop (first .. last sample, :func:`stops`) of ``rec``, at the least, with the stop: ``model``'s drive
+    force (alpha times the command through its delay, lag, deadzone and saturation, eq. 2) and its track force
     (offset, cogging at the stop's reading) integrated twice from the stop's start, with the pendulum's
     reaction (the cart's equation of paper eqs. 1-2: (M + m) x'' + m l (theta' cos(theta))' = F, so m l
     (sin(theta) - sin(theta_0)) after two integrals), against every start speed (a line in time, which takes
@@ -389,29 +389,35 @@ def unheld_travel(rec: Record, model: Model, first: int, last: int) -> float:
     term (beta + eps) x' gives at most (beta + eps) w t, and that much is allowed, as is the angle's
     rounding. 0 where the stop is consistent with no static friction at all."""
     tr = model.vectors().truth
-    idx = np.arange(first, last + 1)
-    t = rec.t[idx] - rec.t[first]
-    volts = drive_means(rec.t, rec.u, tr.input_delay_s, tr.input_lag_s)[idx]
-    cart = rec.x[first]
-    track = undeclared_force(tr.force_vector(), cart, 0.0)
-    force = np.array([model['alpha'] * input_effects(v, tr.deadzone_V, tr.saturation_V) for v in volts]) + track
-    h = np.diff(t)
-    impulse = np.concatenate([[0.0], np.cumsum(force[:-1] * h)])
-    travel = np.concatenate([[0.0], np.cumsum(impulse[:-1] * h + 0.5 * force[:-1] * h ** 2)])
-    mass, swing = model['M'], 0.0
-    if rec.theta is not None and model.pendulum:
-        mass += model['m']
-        travel -= model['m'] * model['l'] * (np.sin(rec.theta[idx]) - math.sin(rec.theta[first]))
-        swing = model['m'] * model['l'] * rec.theta_resolution      # the angle's rounding, twice half a count
-    valid = rec.valid_mask[idx]
-    g, tv = travel[valid] / mass, t[valid]
+    volts = drive_means(rec.t, rec.u, tr.input_delay_s, tr.input_lag_s)
+    forces = tr.force_vector()
     w = rec.x_resolution + model.get('backlash_m')
-    slack = (model['beta'] + model['eps']) * w * tv / mass
-    # min over the start speed a of max_k |g_k - a t_k| - slack_k: a linear programme in (a, e)
-    ones = np.ones_like(tv)
-    res = linprog([0.0, 1.0], A_ub=np.vstack([np.column_stack([-tv, -ones]), np.column_stack([tv, -ones])]),
-                  b_ub=np.concatenate([slack - g, slack + g]), bounds=[(None, None), (None, None)], method='highs')
-    return max(float(res.x[1]) - w - swing / mass, 0.0) if res.success else 0.0
+    mass, swing = model['M'], 0.0
+    pendulum = rec.theta is not None and model.pendulum
+    if pendulum:
+        mass += model['m']
+        swing = model['m'] * model['l'] * rec.theta_resolution      # the angle's rounding, twice half a count
+    out = []
+    for first, last in stops(rec):
+        idx = np.arange(first, last + 1)
+        t = rec.t[idx] - rec.t[first]
+        force = np.array([model['alpha'] * input_effects(v, tr.deadzone_V, tr.saturation_V)
+                          for v in volts[idx]]) + undeclared_force(forces, rec.x[first], 0.0)
+        h = np.diff(t)
+        impulse = np.concatenate([[0.0], np.cumsum(force[:-1] * h)])
+        travel = np.concatenate([[0.0], np.cumsum(impulse[:-1] * h + 0.5 * force[:-1] * h ** 2)])
+        if pendulum:
+            travel -= model['m'] * model['l'] * (np.sin(rec.theta[idx]) - math.sin(rec.theta[first]))
+        valid = rec.valid_mask[idx]
+        g, tv = travel[valid] / mass, t[valid]
+        slack = (model['beta'] + model['eps']) * w * tv / mass
+        # min over the start speed a of max_k |g_k - a t_k| - slack_k: a linear programme in (a, e)
+        ones = np.ones_like(tv)
+        res = linprog([0.0, 1.0], A_ub=np.vstack([np.column_stack([-tv, -ones]), np.column_stack([tv, -ones])]),
+                      b_ub=np.concatenate([slack - g, slack + g]), bounds=[(None, None), (None, None)],
+                      method='highs')
+        out.append((max(float(res.x[1]) - w - swing / mass, 0.0) if res.success else 0.0, first, last))
+    return out
 
 
 def never_holds(recs, model: Model) -> list[str]:
@@ -419,13 +425,13 @@ def never_holds(recs, model: Model) -> list[str]:
     validation parts; a stop is what the data show, in either): a law without static friction (the viscous
     law) moves the cart under any force, and the records show stops (:func:`stops`) over which the forces of
     the drive, the track and the pendulum would have moved it beyond HOLD_COUNTS encoder counts
-    (:func:`unheld_travel`; the ESP32 cart's log at 0.1 Hz stood still for 0.11 s under commands of up to 4.6
+    (:func:`unheld_travels`; the ESP32 cart's log at 0.1 Hz stood still for 0.11 s under commands of up to 4.6
     V, where a cart without static friction leaves its count by 13 counts). Not judged with a drive play (its
     motor side takes the force across the play while the cart stands)."""
     if model.law != 'viscous' or 'drive_backlash' in model.effects:
         return []
-    moved = [(unheld_travel(rec, model, a, b) / rec.x_resolution, rec.t[a], rec.t[b] - rec.t[a])
-             for rec in recs for a, b in stops(rec)]
+    moved = [(travel / rec.x_resolution, rec.t[a], rec.t[b] - rec.t[a])
+             for rec in recs for travel, a, b in unheld_travels(rec, model)]
     beyond = [m for m in moved if m[0] >= HOLD_COUNTS]
     if not beyond:
         return []
