@@ -182,6 +182,13 @@ def _kind(name: str, pendulum: bool = True) -> str:
     return next(('/'.join(sorted(g)) for g in groups if name in g), name)
 
 
+def named_kinds(expected: dict, added: list) -> list[str]:
+    """The groups (:func:`_kind`) of the answers ``added``, each read as the effect of ``expected`` it is
+    another name of (``expected['alike']``: a drive's play closed for a heavier cart, and the reverse)."""
+    alike = expected.get('alike', {})
+    return [_kind(alike.get(n, n), expected.get('pendulum', True)) for n in added]
+
+
 def outcome(expected: dict, predicted: dict) -> str:
     """correct | alike (an effect that acts alike named: :data:`ALIKE`; a drive below the encoder's play
     named with its play closed, :data:`CLOSED_DRIVE`; or, for a wrong constant, the
@@ -192,9 +199,7 @@ def outcome(expected: dict, predicted: dict) -> str:
         return 'error'
     if p == e:
         return 'correct'
-    named = [expected.get('alike', {}).get(n, n) for n in predicted['added']]
-    if expected['library'] and predicted['added'] and \
-            sorted(_kind(n, expected['pendulum']) for n in named) == \
+    if expected['library'] and predicted['added'] and sorted(named_kinds(expected, predicted['added'])) == \
             sorted(_kind(n, expected['pendulum']) for n in expected['library']):
         return 'alike'
     if e == 'none':
@@ -408,7 +413,7 @@ def summarize(cases: list[dict], threshold: float, meta: dict) -> dict:
                 continue
             if comp['library']:
                 pendulum = c['expected_detail'].get('pendulum', True)
-                ok = _kind(comp['name'], pendulum) in [_kind(n, pendulum) for n in c['added']]
+                ok = _kind(comp['name'], pendulum) in named_kinds(c['expected_detail'], c['added'])
             else:
                 ok = c['predicted'] == 'not_explained'
             per_effect[comp['name']].append((comp['counts'], ok, c['predicted'], c['case']))

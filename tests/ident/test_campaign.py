@@ -216,6 +216,27 @@ def test_a_drive_whose_play_is_not_seen_expects_the_mass_of_its_motor_side():
     assert scorer.outcome(contact, scorer.predicted_answer(mass)) == 'wrong'       # its ringing is left
 
 
+def test_an_answer_counted_alike_counts_its_effect_named():
+    """The per-effect tally (detection limits) reads an answer as the outcome does: a drive whose play the
+    encoder cannot show, answered with its play closed, names the mass correction it is scored as."""
+    truth = _truth((('drive_backlash', 260.0),))
+    truth['effects']['drive_backlash'].update(play_contribution_counts_rms=10.6, motor_mass_kg=0.12, gap_m=1e-5)
+    truth.update(encoder={'x_count_m': 2.5e-5})
+    exp = scorer.expected_answer(truth, 2.0)
+    assert exp['label'] == 'M corrected' and exp['alike'] == {scorer.CLOSED_DRIVE: 'M corrected'}
+    closed = {'effects_added': ['drive_backlash'], 'verdict': {'explained': True},
+              'ladder': [{'params': [{'name': 'drive_backlash_m', 'value': 1e-9, 'fitted': False}]}]}
+    rows = []
+    for i, result in enumerate((closed, {'effects_added': ['offset'], 'verdict': {'explained': True}})):
+        pred = scorer.predicted_answer(result)
+        rows.append(dict(case=f'case{i}', experiment='cart', theta_column='none', components=scorer.components(truth),
+                         expected=exp['label'], expected_detail=exp, predicted=pred['label'], added=pred['added'],
+                         outcome=scorer.outcome(exp, pred), oracle_counts=None, wall_s=1.0, generation_s=1.0))
+    assert [r['outcome'] for r in rows] == ['alike', 'wrong']
+    points = scorer.summarize(rows, 2.0, {})['per_effect']['M corrected']['points']
+    assert [p['named'] for p in points] == [True, False]
+
+
 def test_standard_errors_are_checked_against_the_truth_on_clean_cases():
     truth = {'friction': {'Fc': 0.5, 'Fs_excess': 0.2, 'eps': 3.0, 'v_s': 0.1}}
 
