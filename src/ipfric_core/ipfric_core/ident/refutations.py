@@ -393,8 +393,8 @@ def unheld_travels(rec: Record, model: Model) -> list[tuple[float, int, int]]:
     forces = tr.force_vector()
     w = rec.x_resolution + model.get('backlash_m')
     mass, swing = model['M'], 0.0
-    pendulum = rec.theta is not None and model.pendulum
-    if pendulum:
+    theta = rec.theta if model.pendulum else None
+    if theta is not None:
         mass += model['m']
         swing = model['m'] * model['l'] * rec.theta_resolution      # the angle's rounding, twice half a count
     out = []
@@ -406,8 +406,8 @@ def unheld_travels(rec: Record, model: Model) -> list[tuple[float, int, int]]:
         h = np.diff(t)
         impulse = np.concatenate([[0.0], np.cumsum(force[:-1] * h)])
         travel = np.concatenate([[0.0], np.cumsum(impulse[:-1] * h + 0.5 * force[:-1] * h ** 2)])
-        if pendulum:
-            travel -= model['m'] * model['l'] * (np.sin(rec.theta[idx]) - math.sin(rec.theta[first]))
+        if theta is not None:
+            travel -= model['m'] * model['l'] * (np.sin(theta[idx]) - math.sin(theta[first]))
         valid = rec.valid_mask[idx]
         g, tv = travel[valid] / mass, t[valid]
         slack = (model['beta'] + model['eps']) * w * tv / mass
