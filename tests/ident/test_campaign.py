@@ -221,17 +221,16 @@ def test_an_answer_counted_alike_counts_its_effect_named():
     encoder cannot show, answered with its play closed, names the mass correction it is scored as."""
     truth = _truth((('drive_backlash', 260.0),))
     truth['effects']['drive_backlash'].update(play_contribution_counts_rms=10.6, motor_mass_kg=0.12, gap_m=1e-5)
-    truth.update(encoder={'x_count_m': 2.5e-5})
+    truth.update(encoder={'x_count_m': 2.5e-5}, index=0, experiment='cart', theta_column='none',
+                 sample_period_s=1e-3, duration_s=30.0, timing={'kind': 'regular'})
     exp = scorer.expected_answer(truth, 2.0)
     assert exp['label'] == 'M corrected' and exp['alike'] == {scorer.CLOSED_DRIVE: 'M corrected'}
     closed = {'effects_added': ['drive_backlash'], 'verdict': {'explained': True},
-              'ladder': [{'params': [{'name': 'drive_backlash_m', 'value': 1e-9, 'fitted': False}]}]}
-    rows = []
-    for i, result in enumerate((closed, {'effects_added': ['offset'], 'verdict': {'explained': True}})):
-        pred = scorer.predicted_answer(result)
-        rows.append(dict(case=f'case{i}', experiment='cart', theta_column='none', components=scorer.components(truth),
-                         expected=exp['label'], expected_detail=exp, predicted=pred['label'], added=pred['added'],
-                         outcome=scorer.outcome(exp, pred), oracle_counts=None, wall_s=1.0, generation_s=1.0))
+              'ladder': [{'step': '+ drive_backlash', 'validation': {'x_rms_counts': 1.0},
+                          'params': [{'name': 'drive_backlash_m', 'value': 1e-9, 'fitted': False}]}]}
+    offset = {'effects_added': ['offset'], 'verdict': {'explained': True}}
+    rows = [scorer.score_case(dict(truth, case=f'case{i}'), {'result': result, 'wall_s': 1.0}, 2.0, 1.0)
+            for i, result in enumerate((closed, offset))]
     assert [r['outcome'] for r in rows] == ['alike', 'wrong']
     points = scorer.summarize(rows, 2.0, {})['per_effect']['M corrected']['points']
     assert [p['named'] for p in points] == [True, False]
