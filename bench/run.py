@@ -267,18 +267,20 @@ def bench_analyze(bag: Path, small: Path, minutes: float) -> list[dict]:
 SIMULATIONS_IN_60_S = 2100
 
 
-def simulation_time(record: Path, repeats: int = 15) -> float:
+def simulation_time(record: Path, repeats: int = 15, law: str = 'exponential', values: dict | None = None) -> float:
     """The median wall time [s] of one simulation of ``record``'s estimation part (identify's default
-    split) with its declared model (the paper's exponential law, Table 1's plant): every window of the
-    cart and of the angle replayed once, the unit of the identification's work
-    (``ident/shooting.predict``), measured in this process after a first call that compiles."""
+    split) with its declared model (the paper's ``law``, Table 1's plant; ``values`` in place of some
+    of its parameters): every window of the cart and of the angle replayed once, the unit of the
+    identification's work (``ident/shooting.predict``), measured in this process after a first call
+    that compiles."""
     from ipfric_core.analysis.records import load
     from ipfric_core.ident import shooting
     from ipfric_core.ident.model import declared, read_declared
     from ipfric_core.physics.params import PlantParams
-    plant, friction = read_declared(None, 'exponential')
+    plant, friction = read_declared(None, law)
     rec = load(record, plant).split(0.6)[0]
-    model = declared(plant or rec.plant or PlantParams(), friction, rec.theta is not None).vectors()
+    model = declared(plant or rec.plant or PlantParams(), friction, rec.theta is not None).with_values(
+        values or {}).vectors()
     windows = [shooting.cart_windows(rec)] + ([shooting.angle_windows(rec)] if rec.theta is not None else [])
 
     def once() -> float:
@@ -332,6 +334,29 @@ def bench_identify(quick: bool) -> list[dict]:
             rows.append({**row, 'ipfric': f'{wall:.3g} s, {ratio:.0f} simulations\' worth', 'ratio': round(ratio),
                          'met': ratio < SIMULATIONS_IN_60_S})
     return rows
+
+
+#: bristles as stiff as the ladder fits them (its sigma0 bound on real logs reaches 5e5 N/m), damped
+#: critically on the paper's cart (sigma1 = 2 sqrt(sigma0 M), as ``ident/starts.py`` starts them)
+STIFF_BRISTLES = {'sigma0': 4e5, 'sigma1': 2 * (4e5 * 0.815) ** 0.5}
+#: a simulation of the dynamic law may cost this many times the exponential law's
+BRISTLE_COST = 4.0
+
+
+def bench_bristles(quick: bool) -> dict:
+    """One simulation of the 2-minute closed-loop record (20 s in quick mode) with the dynamic law's
+    bristles at STIFF_BRISTLES, beside the exponential law's in the same run: the bristles relax at
+    sigma0 |v| / g(v), up to 1e5 /s, a rate the integrator takes exactly (``simulate.etd_bristles``)."""
+    from bench.independent_code import rigsim
+    record = rigsim.write_case('loop_cogging', REPO_ROOT / 'runs' / 'bench-bristles', duration=20.0 if quick else 120.0)
+    repeats = 3 if quick else 15
+    ref = simulation_time(record, repeats)
+    dyn = simulation_time(record, repeats, 'dynamic', STIFF_BRISTLES)
+    return {'benchmark': f'one simulation of the {"20-s" if quick else "2-min"} 1 kHz closed-loop record\'s estimation '
+                         f'part, dynamic law with stiff bristles (sigma0 {STIFF_BRISTLES["sigma0"]:.0e} N/m)',
+            'reference': f'exponential law {1e3 * ref:.3g} ms', 'ipfric': f'{1e3 * dyn:.3g} ms',
+            'ratio': round(dyn / ref, 2), 'target': f'<= {BRISTLE_COST:g}x the exponential law',
+            'met': dyn <= BRISTLE_COST * ref}
 
 
 def bench_campaign(quick: bool, n_cases: int, seed: int = 1) -> list[dict]:
@@ -463,6 +488,8 @@ def run_all(quick: bool = False, realtime_s: float = 600.0, results: Path | None
     rows += bench_analyze(bag, work / 'lockstep' / 'bag', (2.0 if quick else realtime_s) / 60)
     progress('[bench] identify ...')
     rows += bench_identify(quick)
+    progress('[bench] dynamic law with stiff bristles ...')
+    rows.append(bench_bristles(quick))
     progress(f'[bench] identification campaign ({1 if quick else campaign_cases} cases) ...')
     rows += bench_campaign(quick, campaign_cases)
     info['load_average_at_end'] = os.getloadavg()
