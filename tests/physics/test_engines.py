@@ -114,7 +114,8 @@ def test_stiff_bristles_match_the_scipy_reference():
     """The dynamic law with bristles as stiff as the ladder fits them (sigma0 4e5 N/m: a relaxation
     rate sigma0 |v| / g(v) near 1e5 /s at speed, steps of 0.22 ms), the hanging pendulum's cart driven
     open loop: ``simulate.etd_bristles`` at the default substep within 2 um and 10 urad of LSODA
-    (rtol 1e-10) over 3 s of reversals and sliding (an RK4 step past its decay limit: 33 mm)."""
+    (rtol 1e-10) over 3 s of reversals and sliding (RK4 steps of that length diverge; exponential
+    steps outside the bristle frame left 0.2 mm in a like run: docs/performance.md)."""
     plant = PlantParams()
     friction = FrictionParams('dynamic', eps=3.0, mu_s=0.0861, mu_c=0.04287, v_s=0.105, gamma=2.0,
                               sigma0=4e5, sigma1=2 * math.sqrt(4e5 * plant.M))
