@@ -346,7 +346,7 @@ BRISTLE_COST = 4.0
 def bench_bristles(quick: bool) -> dict:
     """One simulation of the 2-minute closed-loop record (20 s in quick mode) with the dynamic law's
     bristles at STIFF_BRISTLES, beside the exponential law's in the same run: the bristles relax at
-    sigma0 |v| / g(v), up to 1e5 /s, a rate the integrator takes exactly (``simulate.etd_bristles``)."""
+    sigma0 |v| / g(v), up to 1e5 /s, a rate the RK4 steps must follow (``simulate.bristle_step``)."""
     from bench.independent_code import rigsim
     record = rigsim.write_case('loop_cogging', REPO_ROOT / 'runs' / 'bench-bristles', duration=20.0 if quick else 120.0)
     repeats = 3 if quick else 15

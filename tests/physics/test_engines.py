@@ -2,7 +2,6 @@
 against an independent scipy solve_ivp (LSODA, event-located stick-slip) reference."""
 import math
 from dataclasses import replace
-from decimal import Decimal, localcontext
 from pathlib import Path
 
 import numpy as np
@@ -13,7 +12,7 @@ from ipfric_core.physics.closedloop import run_closed_loop
 from ipfric_core.physics.params import FrictionParams, PlantParams
 from ipfric_core.physics.plant import NO_EXTRA_FORCE, CartPendulum
 from ipfric_core.physics.rig import PlantTruth
-from ipfric_core.physics.simulate import Simulator, etd_weights
+from ipfric_core.physics.simulate import Simulator
 from ipfric_core.run.scenario import load_scenario
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -110,15 +109,18 @@ def test_compiled_engine_matches_the_scipy_reference():
     assert np.max(np.abs(comp.state[:, 1] - ref.state[:, 1])) < 1e-4
 
 
-def test_stiff_bristles_match_the_scipy_reference():
-    """The dynamic law with bristles as stiff as the ladder fits them (sigma0 4e5 N/m: a relaxation
-    rate sigma0 |v| / g(v) near 1e5 /s at speed, steps of 0.22 ms), the hanging pendulum's cart driven
-    open loop: ``simulate.etd_bristles`` at the default substep within 2 um and 10 urad of LSODA
-    (rtol 1e-10) over 3 s of reversals and sliding (RK4 steps of that length diverge; exponential
-    steps outside the bristle frame left 0.2 mm in a like run: docs/performance.md)."""
-    plant = PlantParams()
+@pytest.mark.parametrize('mass, sigma0, sigma1', [
+    (0.815, 4e5, 2 * math.sqrt(4e5 * 0.815)),   # as stiff as the ladder fits them, damped critically
+    (1.3, 9.3e4, 19270.0),                       # overdamped, as a campaign fit left them
+])
+def test_stiff_bristles_match_the_scipy_reference(mass, sigma0, sigma1):
+    """The dynamic law with stiff bristles (a relaxation rate sigma0 |v| / g(v) near 1e5 /s at speed),
+    the hanging pendulum's cart driven open loop: RK4 at the default substep, in the steps of
+    ``simulate.bristle_step``, within 0.5 um and 2 urad of LSODA (rtol 1e-10) over 3 s of reversals and
+    sliding of 0.3-0.4 m (steps of 2.5 over the damping rate left 2.2 um in a like overdamped run)."""
+    plant = PlantParams(M=mass)
     friction = FrictionParams('dynamic', eps=3.0, mu_s=0.0861, mu_c=0.04287, v_s=0.105, gamma=2.0,
-                              sigma0=4e5, sigma1=2 * math.sqrt(4e5 * plant.M))
+                              sigma0=sigma0, sigma1=sigma1)
     model = CartPendulum(plant, friction)
     hanging = [0.0, math.pi, 0.0, 0.0]
     sim, ref = Simulator(model, hanging), ScipySimulator(model, hanging, NO_EXTRA_FORCE)
@@ -131,19 +133,6 @@ def test_stiff_bristles_match_the_scipy_reference():
         x_ref.append(ref.state[:2])
         z.append(sim.state[4])
     x, x_ref = np.array(x), np.array(x_ref)
-    assert np.ptp(x[:, 0]) > 0.1 and np.ptp(z) > 2e-6        # slides over 10 cm, the bristles reverse
+    assert np.ptp(x[:, 0]) > 0.25 and np.ptp(z) > 2e-6       # slides over 25 cm, the bristles reverse
     err = np.max(np.abs(x - x_ref), axis=0)
-    assert err[0] < 2e-6 and err[1] < 1e-5, err
-
-
-@pytest.mark.parametrize('x', [-1.0, -1.7, -3.0, -40.0])
-def test_exponential_rk4_weights_match_their_closed_forms(x):
-    """Cox and Matthews' weights in floating point, from the least a h that takes them (ETD_FROM),
-    against their closed forms in 40-digit decimal arithmetic."""
-    with localcontext() as ctx:
-        ctx.prec = 40
-        d = Decimal(x)
-        e = d.exp()
-        closed = ((-4 - d + e * (4 - 3 * d + d * d)) / d ** 3, (2 + d + e * (d - 2)) / d ** 3,
-                  (-4 - 3 * d - d * d + e * (4 - d)) / d ** 3)
-    np.testing.assert_allclose(etd_weights(x), [float(c) for c in closed], rtol=1e-13, atol=1e-16)
+    assert err[0] < 5e-7 and err[1] < 2e-6, err

@@ -40,7 +40,7 @@ from .params import FrictionParams
 
 __all__ = ['DYNAMIC', 'FP_MODEL', 'FP_EPS', 'FP_SIGMA0', 'FP_SIGMA1', 'FP_ASYM', 'friction_vector', 'sticks',
            'static_limit', 'holding_margin', 'holds', 'sliding_level', 'bristle_level', 'friction_force',
-           'bristle_relaxation', 'bristle_rate', 'friction_forces', 'bristle_path', 'Friction']
+           'bristle_rate', 'friction_forces', 'bristle_path', 'Friction']
 
 #: Codes of the friction models in a parameter vector (floats, so the vector is uniform).
 MODEL_CODES = {'viscous': 0.0, 'coulomb': 1.0, 'exponential': 2.0, 'dynamic': 3.0}
@@ -148,20 +148,11 @@ def friction_force(fp, v: float, z: float, direction: float) -> float:
 
 
 @compiled
-def bristle_relaxation(fp, v: float) -> float:
-    """Relaxation rate a = sigma0 |v| / g(v) of the bristle deflection at speed ``v`` [1/s], eq. (10)
-    (z' = v - a z); 0 for the other laws."""
-    if fp[FP_MODEL] != DYNAMIC:
-        return 0.0
-    return fp[FP_SIGMA0] * abs(v) / bristle_level(fp, v)
-
-
-@compiled
 def bristle_rate(fp, v: float, z: float) -> float:
     """Bristle deflection rate z' [m/s], eq. (10); 0 for the other laws."""
     if fp[FP_MODEL] != DYNAMIC:
         return 0.0
-    return v - bristle_relaxation(fp, v) * z
+    return v - fp[FP_SIGMA0] * abs(v) * z / bristle_level(fp, v)
 
 
 @compiled
@@ -185,7 +176,7 @@ def bristle_path(fp, v, dt: float):
     zk = 0.0
     for k in range(len(v)):
         if v[k] != 0.0:
-            a = bristle_relaxation(fp, v[k])
+            a = fp[FP_SIGMA0] * abs(v[k]) / bristle_level(fp, v[k])
             zss = v[k] / a
             zk = zss + (zk - zss) * math.exp(-a * dt)
         z[k] = zk

@@ -15,14 +15,13 @@ import math
 import numpy as np
 
 from .compiled import compiled
-from .friction import FP_SIGMA1, Friction, bristle_rate, friction_force
+from .friction import Friction, bristle_rate, friction_force
 from .params import FrictionParams, PlantParams
 
 __all__ = ['plant_vector', 'motor_force', 'held_force', 'required_forces', 'held_forces', 'pendulum_residuals',
            'stuck_theta_acceleration', 'undeclared_force', 'NO_EXTRA_FORCE', 'motor_side_free', 'drive_contact_force',
            'drive_contact_depth',
-           'undeclared_forces', 'rates', 'effective_mass', 'force_response', 'to_bristle_frame', 'from_bristle_frame',
-           'bristle_frame_rates', 'CartPendulum', 'cogging_amplitude_phase']
+           'undeclared_forces', 'rates', 'CartPendulum', 'cogging_amplitude_phase']
 
 # Positions in the plant vector.
 M, MP, L, G, ALPHA, BETA = range(6)
@@ -40,29 +39,11 @@ def motor_force(pp, voltage: float, x_dot: float) -> float:
 
 
 @compiled
-def effective_mass(pp, c: float) -> float:
-    """M + m - (3/4) m cos^2(theta) [kg] at cos(theta) = ``c``: the cart's inertia to a horizontal force
-    with the pendulum free, eq. (16)."""
-    return pp[M] + pp[MP] - 0.75 * pp[MP] * c * c
-
-
-@compiled
-def force_response(pp, theta: float):
-    """(x'', theta'') per newton of horizontal force on the cart, eq. (16) [1/kg, rad/(m kg)], and
-    their derivatives along theta: (rx, rtheta, drx/dtheta, drtheta/dtheta)."""
-    s, c = math.sin(theta), math.cos(theta)
-    den = effective_mass(pp, c)
-    dden = 1.5 * pp[MP] * c * s
-    lever = (4.0 / 3.0) * pp[L]
-    return 1.0 / den, -c / (lever * den), -dden / (den * den), (s * den + c * dden) / (lever * den * den)
-
-
-@compiled
 def accelerations(pp, theta: float, theta_dot: float, force: float):
     """(x'', theta'') from eq. (16) for a total horizontal force on the cart [N]."""
     m, l, g = pp[MP], pp[L], pp[G]
     s, c = math.sin(theta), math.cos(theta)
-    den = effective_mass(pp, c)
+    den = pp[M] + m - 0.75 * m * c * c
     xdd = (force + m * l * s * theta_dot ** 2 - 0.75 * m * g * c * s) / den
     thdd = (-force * c - m * l * s * c * theta_dot ** 2 + (pp[M] + m) * g * s) / ((4.0 / 3.0) * l * den)
     return xdd, thdd
@@ -90,7 +71,7 @@ def required_forces(pp, x_ddot, theta, theta_dot):
     out = np.empty(len(x_ddot))
     for k in range(len(x_ddot)):
         s, c = math.sin(theta[k]), math.cos(theta[k])
-        out[k] = x_ddot[k] * effective_mass(pp, c) - m * l * s * theta_dot[k] ** 2 + 0.75 * m * g * c * s
+        out[k] = x_ddot[k] * (pp[M] + m - 0.75 * m * c * c) - m * l * s * theta_dot[k] ** 2 + 0.75 * m * g * c * s
     return out
 
 
@@ -213,42 +194,6 @@ def rates(pp, fp, ef, s, voltage: float, direction: float):
          + undeclared_force(ef, s[0], x_dot))
     xdd, thdd = accelerations(pp, theta, theta_dot, f)
     return x_dot, theta_dot, xdd, thdd, bristle_rate(fp, x_dot, z)
-
-
-@compiled
-def to_bristle_frame(pp, fp, s):
-    """State (x, theta, w1, w2, z) of the dynamic law's bristle frame from s = (x, theta, x', theta', z):
-    (w1, w2) = (x', theta') + sigma1 z (rx, rtheta), the velocities the cart and the pendulum would have
-    without the bristle damping's impulse (:func:`force_response`). Eq. (11)'s force sigma1 z' is
-    stiff where the bristles relax fast; in this frame it is gone from the rates
-    (:func:`bristle_frame_rates`)."""
-    rx, rth, _dx, _dth = force_response(pp, s[1])
-    k = fp[FP_SIGMA1] * s[4]
-    return s[0], s[1], s[2] + k * rx, s[3] + k * rth, s[4]
-
-
-@compiled
-def from_bristle_frame(pp, fp, y):
-    """State (x, theta, x', theta', z) from the bristle frame's (:func:`to_bristle_frame`)."""
-    rx, rth, _dx, _dth = force_response(pp, y[1])
-    k = fp[FP_SIGMA1] * y[4]
-    return y[0], y[1], y[2] - k * rx, y[3] - k * rth, y[4]
-
-
-@compiled
-def bristle_frame_rates(pp, fp, ef, y, voltage: float):
-    """dy/dt in the bristle frame (:func:`to_bristle_frame`) of the dynamic law, eqs. (10)-(11) and (16):
-    the accelerations of every force but sigma1 z', plus sigma1 z times the change of the force
-    response along theta'."""
-    x, theta, w1, w2, z = y
-    rx, rth, drx, drth = force_response(pp, theta)
-    k = fp[FP_SIGMA1] * z
-    x_dot, theta_dot = w1 - k * rx, w2 - k * rth
-    zr = bristle_rate(fp, x_dot, z)
-    f = (motor_force(pp, voltage, x_dot) + friction_force(fp, x_dot, z, 0.0) + fp[FP_SIGMA1] * zr
-         + undeclared_force(ef, x, x_dot))
-    xdd, thdd = accelerations(pp, theta, theta_dot, f)
-    return x_dot, theta_dot, xdd + k * drx * theta_dot, thdd + k * drth * theta_dot, zr
 
 
 class CartPendulum:
