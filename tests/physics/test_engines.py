@@ -136,3 +136,14 @@ def test_stiff_bristles_match_the_scipy_reference(mass, sigma0, sigma1):
     assert np.ptp(x[:, 0]) > 0.25 and np.ptp(z) > 2e-6       # slides over 25 cm, the bristles reverse
     err = np.max(np.abs(x - x_ref), axis=0)
     assert err[0] < 5e-7 and err[1] < 2e-6, err
+
+
+def test_bristles_without_damping_take_steps_too():
+    """sigma1 = eps = 0, the ladder's lower bounds: the step rule divides by no damping rate; the hanging
+    pendulum's cart, driven at 2 V for 1 s, slides a third of a metre."""
+    friction = FrictionParams('dynamic', eps=0.0, mu_s=0.0861, mu_c=0.04287, v_s=0.105, gamma=2.0, sigma0=4e5,
+                              sigma1=0.0)
+    sim = Simulator(CartPendulum(PlantParams(), friction), [0.0, math.pi, 0.0, 0.0])
+    for _ in range(1000):
+        sim.step(2.0, 0.001)
+    assert np.all(np.isfinite(sim.state)) and 0.25 < sim.state[0] < 0.45

@@ -214,8 +214,10 @@ def bristle_step(pp, fp, v: float, h: float) -> float:
     no more than MAX_BRISTLE_STEPS steps in ``h``. ``h`` for the other laws."""
     if fp[FP_MODEL] != DYNAMIC:
         return h
-    step = min(h, 2.0 * math.pi * math.sqrt(pp[0] / fp[FP_SIGMA0]) / CONTACT_STEPS,
-               1.0 / ((fp[FP_SIGMA1] + fp[FP_EPS]) / pp[0]))
+    step = min(h, 2.0 * math.pi * math.sqrt(pp[0] / fp[FP_SIGMA0]) / CONTACT_STEPS)
+    damping = (fp[FP_SIGMA1] + fp[FP_EPS]) / pp[0]
+    if damping * step > 1.0:
+        step = 1.0 / damping
     relax = fp[FP_SIGMA0] * abs(v) / bristle_level(fp, v)
     if relax * step > RELAX_STEP:
         step = RELAX_STEP / relax
