@@ -53,10 +53,6 @@ __all__ = ['held', 'advance', 'advance_drive', 'friction_now', 'Simulator']
 MAX_EVENTS = 64  # per substep; a guard, never reached in normal motion
 XTOL = 1e-13     # event time tolerance [s]
 CONTACT_STEPS = 40       # steps per period of the drive's contact oscillation (and of the bristles')
-#: the bristles' relaxation rate times the RK4 step at most [1]: RK4 damps a decay up to 2.785, and the
-#: motion is as close to LSODA's at 2.5 as at 1 (docs/performance.md); the damping rate's is not (its
-#: steps stay at 1 over it)
-RELAX_STEP = 2.5
 MAX_BRISTLE_STEPS = 100   # steps of the dynamic law within one substep at most (stiffer bristles than a
 #                           record's substep can carry diverge, and their fit fails on its own)
 NO_DRIVE = (0.0, 0.0, 0.0, 0.0)   # (play [m], motor-side mass [kg], stiffness [N/m], damping [N s/m]): rigid
@@ -209,18 +205,15 @@ def _advance_hybrid(pp, fp, ef, s, mode, h, voltage):
 @compiled
 def bristle_step(pp, fp, v: float, h: float) -> float:
     """Largest RK4 step [s] of the dynamic law (eqs. 10-11) at speed ``v`` [m/s]: ``h``, CONTACT_STEPS
-    per period 2 pi sqrt(M / sigma0) of the bristles' oscillation with the cart, at most 1 over the damping
-    rate (sigma1 + eps) / M and at most RELAX_STEP over the bristles' relaxation rate sigma0 |v| / g(v);
-    no more than MAX_BRISTLE_STEPS steps in ``h``. ``h`` for the other laws."""
+    per period 2 pi sqrt(M / sigma0) of the bristles' oscillation with the cart, and at most 1 over the
+    bristles' relaxation rate sigma0 |v| / g(v) and the damping rate (sigma1 + eps) / M (RK4 is stable
+    to 2.8 over a rate); no more than MAX_BRISTLE_STEPS steps in ``h``. ``h`` for the other laws."""
     if fp[FP_MODEL] != DYNAMIC:
         return h
     step = min(h, 2.0 * math.pi * math.sqrt(pp[0] / fp[FP_SIGMA0]) / CONTACT_STEPS)
-    damping = (fp[FP_SIGMA1] + fp[FP_EPS]) / pp[0]
-    if damping * step > 1.0:
-        step = 1.0 / damping
-    relax = fp[FP_SIGMA0] * abs(v) / bristle_level(fp, v)
-    if relax * step > RELAX_STEP:
-        step = RELAX_STEP / relax
+    rate = max(fp[FP_SIGMA0] * abs(v) / bristle_level(fp, v), (fp[FP_SIGMA1] + fp[FP_EPS]) / pp[0])
+    if rate * step > 1.0:
+        step = 1.0 / rate
     return max(step, h / MAX_BRISTLE_STEPS)
 
 
