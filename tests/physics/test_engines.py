@@ -9,7 +9,7 @@ import pytest
 
 from bench.scipy_reference import ScipySimulator, run_scipy
 from ipfric_core.physics.closedloop import run_closed_loop
-from ipfric_core.physics.params import FrictionParams, PlantParams
+from ipfric_core.physics.params import PlantParams
 from ipfric_core.physics.plant import NO_EXTRA_FORCE, CartPendulum
 from ipfric_core.physics.rig import PlantTruth
 from ipfric_core.physics.simulate import Simulator
@@ -109,17 +109,23 @@ def test_compiled_engine_matches_the_scipy_reference():
     assert np.max(np.abs(comp.state[:, 1] - ref.state[:, 1])) < 1e-4
 
 
-PAPER_STRIBECK = dict(mu_s=0.0861, mu_c=0.04287, v_s=0.105, gamma=2.0)
+#: the paper's dynamic law and plant (Tables 1, 3 and 4), from the scenario of Figure 10
+FIG10 = scenario('fig10_new_gain_dynamic')
+
+
+def bristles(sigma0, sigma1, **law):
+    """The paper's dynamic law with bristles of stiffness ``sigma0`` [N/m] and damping ``sigma1`` [N s/m]."""
+    return replace(FIG10.friction, sigma0=sigma0, sigma1=sigma1, **law)
 
 
 @pytest.mark.parametrize('plant, friction', [
-    # as stiff as the ladder fits them, damped critically
-    (PlantParams(), dict(PAPER_STRIBECK, eps=3.0, sigma0=4e5, sigma1=2 * math.sqrt(4e5 * 0.815))),
+    # as stiff as the ladder fits them, damped critically (sigma1 = 2 sqrt(sigma0 M), as starts.bristle_starts)
+    (FIG10.plant, bristles(4e5, 2 * math.sqrt(4e5 * FIG10.plant.M))),
     # overdamped
-    (PlantParams(M=1.3), dict(PAPER_STRIBECK, eps=3.0, sigma0=9.3e4, sigma1=19270.0)),
+    (replace(FIG10.plant, M=1.3), bristles(9.3e4, 19270.0)),
     # the fit of seed 2027's case 153: overdamped, a level rising with speed (static below Coulomb)
     (PlantParams(M=1.295, alpha=2.81, beta=9.05),
-     dict(eps=0.0, mu_s=0.014857, mu_c=0.206935, v_s=0.4947, gamma=2.0, sigma0=93344.4, sigma1=19270.3)),
+     bristles(93344.4, 19270.3, eps=0.0, mu_s=0.014857, mu_c=0.206935, v_s=0.4947)),
 ])
 def test_stiff_bristles_match_the_scipy_reference(plant, friction):
     """The dynamic law with stiff bristles (a relaxation rate sigma0 |v| / g(v) near 1e5 /s at speed),
@@ -127,7 +133,7 @@ def test_stiff_bristles_match_the_scipy_reference(plant, friction):
     ``simulate.bristle_step``, within 0.5 um and 2 urad of LSODA (rtol 1e-10) over 3 s of reversals and
     sliding of 0.25-0.45 m. Steps of 2.5 over the relaxation rate left 0.10 mm on case 153's fit, steps
     of 2.5 over the damping rate 2.2 um on a like overdamped run (docs/performance.md)."""
-    model = CartPendulum(plant, FrictionParams('dynamic', **friction))
+    model = CartPendulum(plant, friction)
     hanging = [0.0, math.pi, 0.0, 0.0]
     sim, ref = Simulator(model, hanging), ScipySimulator(model, hanging, NO_EXTRA_FORCE)
     x, x_ref, z = [], [], []
@@ -147,8 +153,7 @@ def test_stiff_bristles_match_the_scipy_reference(plant, friction):
 def test_bristles_without_damping_take_steps_too():
     """sigma1 = eps = 0, the ladder's lower bounds: the step rule divides by no damping rate; the hanging
     pendulum's cart, driven at 2 V for 1 s, slides a third of a metre."""
-    friction = FrictionParams('dynamic', **PAPER_STRIBECK, eps=0.0, sigma0=4e5, sigma1=0.0)
-    sim = Simulator(CartPendulum(PlantParams(), friction), [0.0, math.pi, 0.0, 0.0])
+    sim = Simulator(CartPendulum(FIG10.plant, bristles(4e5, 0.0, eps=0.0)), [0.0, math.pi, 0.0, 0.0])
     for _ in range(1000):
         sim.step(2.0, 0.001)
     assert np.all(np.isfinite(sim.state)) and 0.25 < sim.state[0] < 0.45
