@@ -49,8 +49,9 @@ CASES = [
     ('loop_backlash', ('drive_backlash',), {'drive_backlash_m': (1e-3, 9e-5), 'drive_mass_kg': (0.2, 0.02)}),
 ]
 #: cases the final model does not explain down to the encoders' floor, and the most it may leave [% of the
-#: motion]: in the closed loop with a drive play even the generator's own values leave 1.65 counts (2.7 %)
-#: against a floor of 0.79 (1.3 %): the contact rings at 180 Hz and two integrators of its knocks part
+#: motion]: in the closed loop with a drive play even the generator's own values leave 1.07 counts (1.8 %)
+#: against a floor of 0.34 (0.56 %; 0.93 counts before the drive's finer steps at its contact's edges, 37ceb16):
+#: the contact rings at 180 Hz and two integrators of its knocks part
 NOT_EXPLAINED = {'loop_backlash': 5.0}
 #: parameters whose simulated error must be reported rough (their errors from a scan, not the Jacobian)
 ROUGH = {'loop_backlash': {'drive_stiffness_N_per_m', 'drive_damping_Ns_per_m'}}
