@@ -299,10 +299,15 @@ def oracle_model_values(truth: dict) -> tuple[dict, list[tuple[str, dict]]]:
         elif name == 'sensor_bias':
             effects.append((name, {'bias_theta_rad': q['theta_bias_rad']}))
         elif name == 'drive_backlash':
-            effects.append((name, {'drive_backlash_m': q['gap_m'], 'drive_mass_kg': q['motor_mass_kg'],
-                                   'drive_stiffness_N_per_m': q['k_N_per_m'],
-                                   'drive_damping_Ns_per_m': q['c_N_s_per_m']}))
+            effects.append((name, drive_values(q)))
     return values, effects
+
+
+def drive_values(q: dict) -> dict:
+    """An independent generator's drive with play (play ``gap_m``, ``motor_mass_kg``, contact ``k_N_per_m`` and
+    ``c_N_s_per_m``) in the identification's parameters."""
+    return {'drive_backlash_m': q['gap_m'], 'drive_mass_kg': q['motor_mass_kg'],
+            'drive_stiffness_N_per_m': q['k_N_per_m'], 'drive_damping_Ns_per_m': q['c_N_s_per_m']}
 
 
 def oracle(case_dir: Path, truth: dict, split: float = 0.6) -> dict:

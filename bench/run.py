@@ -373,13 +373,12 @@ def bench_drive(quick: bool) -> dict:
     rigsim.EFFECTS['backlash'], 1 mm, 0.2 kg behind a 2e5 N/m contact, 30 s; 20 s in quick mode) beside the
     same record's simulation without the drive, in the same run: the contact's oscillation sets the steps
     (``simulate.drive_step``), finer where the contact closes or opens (``simulate.advance_drive``)."""
+    from bench.ident_campaign import drive_values
     from bench.independent_code import rigsim
-    drive = rigsim.EFFECTS['backlash']
     record = rigsim.write_case('loop_backlash', REPO_ROOT / 'runs' / 'bench-drive', duration=20.0 if quick else 30.0)
     repeats = 3 if quick else 15
     ref = simulation_time(record, repeats)
-    true = {'drive_backlash_m': drive['gap_m'], 'drive_mass_kg': drive['motor_mass_kg'],
-            'drive_stiffness_N_per_m': drive['k_N_per_m'], 'drive_damping_Ns_per_m': drive['c_N_s_per_m']}
+    true = drive_values(rigsim.EFFECTS['backlash'])
     with_drive = simulation_time(record, repeats, effect='drive_backlash', values=true)
     return {'benchmark': f'one simulation of a {"20-s" if quick else "30-s"} 1 kHz balancing loop\'s estimation part '
                          'with its drive with play (1 mm, 0.2 kg, 2e5 N/m)',

@@ -17,7 +17,7 @@ from scipy.integrate import solve_ivp
 
 from ipfric_core.physics.closedloop import run_closed_loop
 from ipfric_core.physics.friction import holds, static_limit, sticks
-from ipfric_core.physics.plant import drive_contact_force, rates, stuck_theta_acceleration
+from ipfric_core.physics.plant import drive_contact_force, force_input, rates, stuck_theta_acceleration
 from ipfric_core.physics.simulate import NO_DRIVE, friction_now, held
 
 RTOL, ATOL = 1e-10, 1e-12
@@ -33,7 +33,7 @@ class ScipySimulator:
         self.y[:len(state0)] = state0
         self.dp = tuple(float(v) for v in drive)
         if self.dp[0] > 0.0:          # the cart takes the contact's force in the motor's place
-            self.pp = (*self.pp[:4], 1.0, 0.0)
+            self.pp = force_input(self.pp)
             self.motor = model.vector
         self.stuck, self.d, self.t = False, 0.0, 0.0
         self.hybrid = sticks(self.fp)

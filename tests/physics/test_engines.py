@@ -159,7 +159,6 @@ def test_bristles_without_damping_take_steps_too():
     assert np.all(np.isfinite(sim.state)) and 0.25 < sim.state[0] < 0.45
 
 
-
 @pytest.mark.parametrize('law, drive, within', [
     # a stiff 150 Hz contact of a heavy motor side (seed 2027's case 131), lightly damped
     ('exponential', (4.5e-4, 0.675, 4.0e5, 121.0), 1.5e-5),
@@ -170,7 +169,7 @@ def test_bristles_without_damping_take_steps_too():
 ])
 def test_a_drive_with_play_matches_the_scipy_reference(law, drive, within):
     """A two-mass drive with play (``simulate.advance_drive``), the hanging pendulum's cart driven open loop
-    by commands held 10 ms through reversals, stops and breakaways for 3 s: the default steps (DRIVE_STEPS
+    by commands held 10 ms through reversals, stops and breakaways for 3 s: the default steps (CONTACT_STEPS
     per contact period, finer where the contact closes or opens) within ``within`` [m] RMS of LSODA (rtol
     1e-10, the motor side and its contact in the reference's state), and steps of 4 us within 2 um (the
     integrator converges to the reference). Without the finer steps at the contact's edges the first two

@@ -20,7 +20,7 @@ from .params import FrictionParams, PlantParams
 
 __all__ = ['plant_vector', 'motor_force', 'held_force', 'required_forces', 'held_forces', 'pendulum_residuals',
            'stuck_theta_acceleration', 'undeclared_force', 'NO_EXTRA_FORCE', 'motor_side_free', 'drive_contact_force',
-           'drive_contact_depth',
+           'drive_contact_depth', 'force_input', 'beyond_play',
            'undeclared_forces', 'rates', 'CartPendulum', 'cogging_amplitude_phase']
 
 # Positions in the plant vector.
@@ -149,18 +149,32 @@ def motor_side_free(pp, mass: float, vb: float, voltage: float, h: float):
 
 
 @compiled
+def force_input(pp):
+    """The plant vector ``pp`` with alpha 1 N/V and beta 0: its "voltage" is then the force on the cart [N]
+    (a drive's contact in the motor's place, eq. 2)."""
+    return (pp[M], pp[MP], pp[L], pp[G], 1.0, 0.0)
+
+
+@compiled
+def beyond_play(dp, d: float) -> bool:
+    """Whether the motor side of a drive ``dp`` (:func:`drive_contact_force`) is beyond an edge of its play,
+    d = motor side minus cart [m]: in contact, unless it is leaving fast."""
+    return abs(d) > 0.5 * dp[0]
+
+
+@compiled
 def drive_contact_force(dp, d: float, dv: float) -> float:
     """Force [N] on the cart from the motor side of a drive with play, ``dp`` = (play [m], motor-side
     mass [kg], contact stiffness k [N/m], contact damping c [N s/m]), d = motor side minus cart [m],
     dv its speed relative to the cart [m/s]: k (d -/+ play/2) + c dv beyond either edge of the play
     (a stiff contact, the usual dead-zone model of a two-mass drive), 0 inside it. A contact only
     pushes: the force never pulls the two together."""
+    if not beyond_play(dp, d):
+        return 0.0
     half = 0.5 * dp[0]
-    if d > half:
+    if d > 0.0:
         return max(dp[2] * (d - half) + dp[3] * dv, 0.0)
-    if d < -half:
-        return min(dp[2] * (d + half) + dp[3] * dv, 0.0)
-    return 0.0
+    return min(dp[2] * (d + half) + dp[3] * dv, 0.0)
 
 
 @compiled

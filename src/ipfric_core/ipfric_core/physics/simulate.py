@@ -39,7 +39,9 @@ from .friction import (
 from .plant import (
     NO_EXTRA_FORCE,
     CartPendulum,
+    beyond_play,
     drive_contact_force,
+    force_input,
     held_force,
     motor_force,
     motor_side_free,
@@ -270,7 +272,7 @@ def advance_drive(pp, fp, ef, s, mode, drive, voltage, dt, substep, dp):
     h = dt / n
     for _ in range(n):
         s1, mode1, d1, vb1 = _drive_step(pp, fp, ef, s, mode, d, vb, voltage, h, dp)
-        if mode1[2] != mode[2] or (abs(d) > 0.5 * dp[0]) != (abs(d1) > 0.5 * dp[0]):   # an edge: finer
+        if mode1[2] != mode[2] or beyond_play(dp, d) != beyond_play(dp, d1):   # an edge: finer steps
             for _ in range(EVENT_SPLIT):
                 s, mode, d, vb = _drive_step(pp, fp, ef, s, mode, d, vb, voltage, h / EVENT_SPLIT, dp)
         else:
@@ -281,7 +283,7 @@ def advance_drive(pp, fp, ef, s, mode, drive, voltage, dt, substep, dp):
 @compiled
 def _drive_step(pp, fp, ef, s, mode, d, vb, voltage, h, dp):
     """One step of :func:`advance_drive` of length ``h`` [s]: (state, mode, d, vb) after it."""
-    on_cart = (pp[0], pp[1], pp[2], pp[3], 1.0, 0.0)   # the "voltage" is then the force on the cart [N]
+    on_cart = force_input(pp)
     f0 = drive_contact_force(dp, d, vb - s[2])
     if mode[0] != 0.0 and holds(fp, held(on_cart, ef, s, f0)):
         moved, v1 = 0.0, 0.0
@@ -368,7 +370,7 @@ class Simulator:
         if self.drive[0] > 0.0:
             d, vb = self._drive
             pp = self._pp
-            return friction_now((pp[0], pp[1], pp[2], pp[3], 1.0, 0.0), self._fp, self.extra_force, self._s,
+            return friction_now(force_input(pp), self._fp, self.extra_force, self._s,
                                 self._mode, drive_contact_force(self.drive, d, vb - self._s[2]))
         return friction_now(self._pp, self._fp, self.extra_force, self._s, self._mode, voltage)
 
