@@ -1,10 +1,12 @@
 """Which hypotheses of a round are fitted in full (``hypotheses.screen``): a plant correction that refits the
 friction levels is measured, as it is judged, by what it adds to the refit's short fit; the two plant
-corrections take no place in the effects' ranks and do not set their bar."""
+corrections take no place in the effects' ranks and do not set their bar; a kept effect's refinement is fitted
+in full outside the ranks."""
 import pytest
 
+from ipfric_core.ident import hypotheses as hyp
 from ipfric_core.ident.effects import EFFECTS
-from ipfric_core.ident.hypotheses import FULL_SHARE, FULL_TOP, Hypothesis, screen
+from ipfric_core.ident.hypotheses import FULL_SHARE, FULL_TOP, SCREEN_GAIN, Hypothesis, screen
 from ipfric_core.ident.model import LAW_PARAMS, load_declared
 
 DECLARED = load_declared(None, 'exponential', False)
@@ -73,3 +75,31 @@ def test_a_plant_correction_does_not_set_the_effects_bar(plant_gain):
     whatever a mass correction adds."""
     notes = round_of({'M': plant_gain}, {'offset': 0.20, 'saturation': 0.11})
     assert notes['saturation'] is None and notes['offset'] is None and notes['M corrected'] is None, notes
+
+
+def test_a_kept_drives_play_opened_is_fitted_in_full_outside_the_ranks(monkeypatch):
+    """A drive kept with its play closed, its play opened (a refinement, one per kept effect): seed 2027's
+    case 74 gained 2.8 % beyond the refit's short fit against the best effect's 15 %, and its play (1.50
+    counts on validation against the closed drive's 2.75) was never fitted. Outside the ranks it is fitted in
+    full once its short fit gains SCREEN_GAIN over the model; the effects' ranks are as before."""
+    monkeypatch.setattr(hyp, 'contradictions', lambda pe, m, effect: [])
+    current = DECLARED.with_effect('drive_backlash')
+    refit = Hypothesis('refit', 'friction', current.with_free(LAW), LAW, LAW)
+    own = EFFECTS['drive_backlash'].params
+    opened = Hypothesis('drive_backlash with its play opened', 'effect',
+                        current.with_free(('drive_backlash_m',) + LAW), own, own + LAW, effect='drive_backlash')
+    assert opened.refines(current) and not opened.refines(DECLARED)
+    hs, costs = [refit, opened], {id(refit.model): 1.0, id(opened.model): 1.0 - 0.028}
+    for name, gain in {'offset': 0.15, 'asymmetry': 0.042, 'cogging': 0.13, 'lag': 0.12, 'delay': 0.11}.items():
+        h = Hypothesis(name, 'effect', current.with_effect(name).with_free(EFFECTS[name].params + LAW),
+                       EFFECTS[name].params, EFFECTS[name].params + LAW, effect=name)
+        hs.append(h)
+        costs[id(h.model)] = 1.0 - gain
+    short = [(h.model, 0.3) for h in hs]
+    notes = dict(zip((h.label for h in hs), screen(hs, short, Costs(costs), current)))
+    assert notes['drive_backlash with its play opened'] is None, notes
+    assert [notes[n] for n in ('offset', 'cogging', 'lag')] == [None] * FULL_TOP
+    assert 'less than' in notes['asymmetry'] and f'not among the {FULL_TOP} best' in notes['delay'], notes
+    # the same short fit below SCREEN_GAIN over the model is not fitted
+    short[1] = (opened.model, 0.5 * SCREEN_GAIN)
+    assert 'not fitted in full' in screen(hs, short, Costs(costs), current)[1]

@@ -72,7 +72,7 @@ def confirm(pe: Problem, pv: Problem, current: Model, j: Judged, prior: Model) -
         if size < CONTRIBUTION_COUNTS:
             why.append(f'it changes the simulated motion by {size:.2g} counts RMS (needs {CONTRIBUTION_COUNTS:g}: '
                        f'too small to matter at the encoders)')
-        elif j.h.effect in current.effects:      # a drive's play opened (hypotheses.with_play_opened)
+        elif j.h.refines(current):      # a drive's play opened (hypotheses.with_play_opened)
             j.notes.append(f'the play of the compliant drive opened: {j.model["drive_backlash_m"] * 1e3:.4g} mm, '
                            f'the contact {j.model["drive_stiffness_N_per_m"]:.4g} N/m (with its play closed '
                            f'{current["drive_stiffness_N_per_m"]:.4g}); it changes the simulated motion by {size:.2g} '
@@ -139,7 +139,7 @@ def closed_play(pe: Problem, pv: Problem, j: Judged, prior: Model) -> tuple[list
     name = 'drive_backlash_m'
     closed = fit_model(pe, j.model.holding({name: CLOSED_PLAY}), only=joint(j.h, j.model) - {name}, prior=prior,
                        errors=False)[0]
-    *_, dropped = drop_checks(pv, closed, j.model, pv.window_sse(closed))
+    *_, dropped = drop_checks(pv, closed, j.model, pv.window_sse(closed), j.p_max)
     *_, worse = drop_checks(pv, j.model, closed, pv.window_sse(j.model))
     return dropped, pv.summary(closed)['x_rms_counts'], not worse
 
@@ -162,7 +162,7 @@ def undone(j: Judged, current: Model) -> Model:
     whose play it opens, back at ``current``'s values), a plant correction's constant
     back at its value in ``current`` with the friction as fitted beside it (a mass corrected by 0.1 % that
     rode in on the refit's friction is no correction), a law or a refit ``current`` itself."""
-    if j.h.effect in current.effects:    # a drive's play opened (:func:`hypotheses.with_play_opened`)
+    if j.h.refines(current):    # a drive's play opened (:func:`hypotheses.with_play_opened`)
         return j.model.with_values({n: current[n] for n in j.h.own})
     if j.h.effect:
         return j.model.without(j.h.effect)
