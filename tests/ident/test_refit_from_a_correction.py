@@ -65,8 +65,9 @@ def test_only_a_plant_correction_is_turned_into_a_refit(parts):
 def test_an_effect_a_later_step_took_over_is_dropped(parts, tmp_path):
     """An effect kept before a later step (an offset a later round's direction dependence took over: seed 2027's
     case 2) is dropped where the final model without it, the rest refitted, leaves the validation error within
-    WORSE_PERCENT (a step '- offset'); the last step's effect is not tried, and the generator's own direction
-    dependence, on a record that holds it, stays though a refit came after it."""
+    WORSE_PERCENT (a step '- offset'); the last step's effect is not tried (nor one only its own refinement
+    followed), and the generator's own direction dependence, on a record that holds it, stays though a refit
+    came after it."""
     from ipfric_core.ident.ladder import Step, drop_spent
     pe, pv = parts
     declared = load_declared(None, 'exponential', False)
@@ -77,6 +78,10 @@ def test_an_effect_a_later_step_took_over_is_dropped(parts, tmp_path):
     assert 'which a later step may have taken over' in ladder[3].notes[0]
     last = [Step(label, current, {}, {}, {}, []) for label in ('declared', 'refit', '+ offset')]
     assert drop_spent(pe, pv, declared, current, last, lambda _msg: None) is current and len(last) == 3
+    # nor is it where only its own refinement came after it (a drive's play opened: 'drive_backlash with its
+    # play opened' after '+ drive_backlash')
+    refined = [Step(label, current, {}, {}, {}, []) for label in ('declared', '+ offset', 'offset refined')]
+    assert drop_spent(pe, pv, declared, current, refined, lambda _msg: None) is current and len(refined) == 3
     rec = load(rigsim.write_case('cart_asymmetry', tmp_path, duration=30.0), None, cart_alone=True)
     est, val = rec.split(0.6)
     truth = refit_of(declared).model.with_effect('asymmetry', {'asymmetry': rigsim.EFFECTS['asymmetry']['a']})
