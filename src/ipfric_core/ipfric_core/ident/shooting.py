@@ -12,7 +12,8 @@ that error through the window: 23 counts RMS where the true model with the rate 
 readings. With a drive play the motor side's state, which no sensor reads, and the cart's rate are the
 model's own over the ``DRIVE_LEAD_S`` before the start (the true drives of 24 cases of the randomised
 campaign: 0.5-134 counts left from the state estimated along the measured cart, 0.4-10 from that lead,
-against floors of 0.3-8.6). The cart is judged on windows of ``CART_WINDOW_S``; with a
+against floors of 0.3-8.6); a window without room for that lead starts at the rate that best replays its
+first readings, as without a drive. The cart is judged on windows of ``CART_WINDOW_S``; with a
 pendulum attached its angle is taken from the measurement there (the upright pendulum is
 unstable: a small error in its initial rate would grow into the cart's motion), and the
 angle itself is judged on short windows of ``PENDULUM_WINDOW_S`` of the free coupled motion. The model (the
@@ -328,8 +329,10 @@ def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, drives, t, 
     :func:`~ipfric_core.physics.simulate.advance_drive` takes it, play > 0): then the window's drive state
     and, in motion, the cart's rate are the model's own over the ``drive_lead_n`` samples before, from the
     drive state ``drives`` (n, 3) of :func:`drive_states` there (a window whose angle is free, that has no
-    room for such a lead, or whose lead diverged, starts from ``drives`` at its start and the local fit's
-    rate)."""
+    room for such a lead, or whose lead diverged, starts from ``drives`` at its start and, in motion, at the
+    rate that best replays its first readings, as a window of a model without a drive does: seed 2027's case
+    67, a balancing loop whose estimation part's first window starts 0.11 s in, left 55.9 counts with the
+    generator's own drive from the local fit's rate, 8.4 from the fitted one, the other 22 windows 0.3-1))."""
     pendulum = pp[1] > 0.0
     for w in numba.prange(len(start)):
         s = (state[w, 0], state[w, 1] - theta_bias, state[w, 2], state[w, 3], state[w, 4])
@@ -337,6 +340,7 @@ def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, drives, t, 
         k0 = start[w]
         dr = (drives[k0, 0], drives[k0, 1])
         reading = s[0]
+        led = False
         if drive[0] > 0.0:
             a = k0 - drive_lead_n
             if a >= 0 and (len(forced) > 0 or not pendulum):
@@ -344,9 +348,10 @@ def _shoot(pp, fp, ef, deadzone, saturation, gap, theta_bias, drive, drives, t, 
                                 (drives[a, 0], drives[a, 1]), substep, forced, theta_bias, pendulum, xm, speed)
                 if math.isfinite(ldr[0]):
                     dr = ldr
+                    led = True
                     if held[w] == 0.0:
                         s = ls
-        elif held[w] == 0.0 and fit_n > 0:
+        if not led and held[w] == 0.0 and fit_n > 0:
             if lead_n > 0:
                 s = _lead(pp, fp, ef, deadzone, saturation, drive, first, durations, commands,
                           max(0, k0 - lead_n), k0, s, dr, substep, forced, theta_bias, pendulum, xm, speed)[0]
