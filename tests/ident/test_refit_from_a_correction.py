@@ -80,7 +80,8 @@ def test_an_effect_a_later_step_took_over_is_dropped(parts, tmp_path):
     assert drop_spent(pe, pv, declared, current, last, lambda _msg: None) is current and len(last) == 3
     # nor is it where only its own refinement came after it (a drive's play opened: 'drive_backlash with its
     # play opened' after '+ drive_backlash')
-    refined = [Step(label, current, {}, {}, {}, []) for label in ('declared', '+ offset', 'offset refined')]
+    refined = [Step(label, current, {}, {}, {}, [], refines) for label, refines in
+               (('declared', None), ('+ offset', None), ('offset refined', 'offset'))]
     assert drop_spent(pe, pv, declared, current, refined, lambda _msg: None) is current and len(refined) == 3
     rec = load(rigsim.write_case('cart_asymmetry', tmp_path, duration=30.0), None, cart_alone=True)
     est, val = rec.split(0.6)

@@ -179,6 +179,7 @@ class Step:
     est: dict
     val: dict
     notes: list
+    refines: str | None = None     # the effect whose refinement this step kept (a drive's play opened), else None
 
 
 def correction_notes(declared: Model, model: Model, std: dict, cart_alone: bool) -> list[str]:
@@ -315,7 +316,8 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
         step_notes += [f'{p.name} held at {p.value:.4g} {p.unit} (damping ratio {DRIVE_GRID[3]:g}): the fit put it '
                        'on a bound, the data do not determine it' for p in current.params
                        if p.name == 'drive_damping_Ns_per_m' and not p.free]
-        steps.append(Step(label, current, s, pe.summary(current), pv.summary(current), step_notes))
+        steps.append(Step(label, current, s, pe.summary(current), pv.summary(current), step_notes,
+                          win.h.effect if win.h.refines(before) else None))
         rounds.append({'round': round_no, 'kept': win.h.label,
                        'runner_up': _alternative(runner, pv) if runner else None})
         say(f'kept {win.h.label}: validation x error {steps[-1].val["x_rms_counts"]:.3g} counts'
@@ -384,14 +386,12 @@ def drop_spent(pe: Problem, pv: Problem, declared: Model, current: Model, steps:
     error within WORSE_PERCENT (a step '- <effect>'), as :func:`undo_corrections` does for a correction:
     seed 2027's case 2, a direction dependence read in round 1 as an offset of -0.49 N, which stayed beside
     it at -0.033 N once round 2 added it (without it, refitted: 0.94 counts on validation against 0.92). Its
-    own refinement after it (a drive's play opened, the step 'drive_backlash with its play opened') is no later
-    step that takes it over."""
-    kept = [st.label for st in steps if st.label != 'declared' and not st.label.endswith(' as declared')]
+    own refinement after it (a drive's play opened: the step's ``refines``) is no later step that takes it
+    over."""
+    kept = [st for st in steps if st.label != 'declared' and not st.label.endswith(' as declared')]
     for name in [e for e in current.effects if e not in declared.effects]:
-        if f'+ {name}' not in kept:
-            continue
-        after = kept[len(kept) - kept[::-1].index(f'+ {name}'):]
-        if all(a.startswith(f'{name} ') for a in after):      # nothing after it but its own refinement
+        at = [i for i, st in enumerate(kept) if st.label == f'+ {name}']
+        if not at or all(st.refines == name for st in kept[at[-1] + 1:]):   # no later step but its refinement
             continue
         current = take_back(pe, pv, declared, current, current.without(name), f'- {name}',
                             f'{name}, which a later step may have taken over, dropped and the rest refitted',
