@@ -27,9 +27,11 @@ the truth and the identification's report (``ident/result.json``, ``ident/stderr
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import math
 import os
+import platform
 import subprocess
 import sys
 import time
@@ -336,7 +338,9 @@ def oracle(case_dir: Path, truth: dict, split: float = 0.6) -> dict:
 
 # ------------------------------------------------------------------------------------- scoring
 def score_case(truth: dict, ident: dict, threshold: float = THRESHOLD, generation_s: float | None = None,
-               oracle_counts: dict | None = None) -> dict:
+               oracle_counts: dict | None = None, data_sha256: str | None = None) -> dict:
+    """One case's row: its truth's components and expected answer, the identification's answer and outcome;
+    ``data_sha256``: the digest of the data the identification read (:func:`data_digest`)."""
     exp = expected_answer(truth, threshold)
     pred = predicted_answer(ident.get('result'))
     res = ident.get('result') or {}
@@ -352,7 +356,25 @@ def score_case(truth: dict, ident: dict, threshold: float = THRESHOLD, generatio
         wall_s=ident.get('wall_s'),
         generation_s=generation_s if generation_s is not None else truth.get('generation_s'),
         rc=ident.get('rc'), stderr_tail=ident.get('stderr_tail'),
-        command=ident.get('command'))
+        command=ident.get('command'), data_sha256=data_sha256)
+
+
+def data_digest(case_dir: Path) -> str:
+    """SHA-256 of a case's data.csv: which draw a row scored. The generator gives the same bytes for the same
+    (seed, index) on one machine; a balancing loop's bytes differ between machines whose floating point
+    differs (the loop amplifies the last bit: docs/identification.md), an open-loop case's do not."""
+    return hashlib.sha256((case_dir / 'data.csv').read_bytes()).hexdigest()
+
+
+def machine() -> dict:
+    """The machine a part ran on (its processor and numpy's SIMD paths): what a balancing loop's draw
+    depends on (:func:`data_digest`)."""
+    from numpy._core._multiarray_umath import __cpu_features__ as features
+    info = Path('/proc/cpuinfo')
+    cpu = next((ln.split(':', 1)[1].strip() for ln in info.read_text().splitlines() if ln.startswith('model name')),
+               '') if info.exists() else ''
+    return dict(cpu=cpu or platform.processor(), arch=platform.machine(), numpy=np.__version__,
+                simd=sorted(k for k, v in features.items() if v and k.startswith(('AVX', 'FMA'))))
 
 
 #: the ladder's law that is the generator's (the exponential Stribeck curve, gamma 2): the friction levels of a
@@ -687,7 +709,8 @@ def run_campaign(out_dir, n_cases, seed, workers=1, progress=None, threshold=THR
         truth = json.loads((d / 'truth.json').read_text())
         if name in done:
             ident = stored_ident(d)
-            return score_case(truth, ident, threshold, manifest['generation_s'].get(name), ident.get('oracle_counts'))
+            return score_case(truth, ident, threshold, manifest['generation_s'].get(name), ident.get('oracle_counts'),
+                              data_digest(d))
         if code_commit() != commit:     # the tree changed under the campaign: its answers would be two codes'
             raise SystemExit(f'{name}: the code changed from {commit} to {code_commit()} during the campaign '
                              '(run it from a worktree of one commit)')
@@ -697,7 +720,7 @@ def run_campaign(out_dir, n_cases, seed, workers=1, progress=None, threshold=THR
         tmp.write_text(json.dumps(dict({k: v for k, v in ident.items() if k != 'result'}, oracle_counts=orc,
                                        commit=commit)))
         os.replace(tmp, d / 'ident' / 'meta.json')
-        return score_case(truth, ident, threshold, manifest['generation_s'].get(name), orc)
+        return score_case(truth, ident, threshold, manifest['generation_s'].get(name), orc, data_digest(d))
 
     # a batch of ``workers`` cases at a time, generated then identified: a stop keeps every case done so far
     cases = []
@@ -715,7 +738,7 @@ def run_campaign(out_dir, n_cases, seed, workers=1, progress=None, threshold=THR
                 generation_wall_s=round(gen_wall, 1),
                 total_wall_s=round(time.perf_counter() - t0, 1),
                 date_utc=time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime()),
-                load_average_at_end=os.getloadavg())
+                load_average_at_end=os.getloadavg(), machine=machine())
     return write_summary(out_dir, cases, threshold, meta)
 
 
@@ -738,7 +761,7 @@ def scored(out_dir, threshold=THRESHOLD, with_oracle=False) -> tuple[list[dict],
         if orc is None and with_oracle:
             orc = oracle(d, truth)
             meta_p.write_text(json.dumps(dict({k: v for k, v in ident.items() if k != 'result'}, oracle_counts=orc)))
-        cases.append(score_case(truth, ident, threshold, gen.get(d.name), orc))
+        cases.append(score_case(truth, ident, threshold, gen.get(d.name), orc, data_digest(d)))
     old = {}
     if (out_dir / 'summary.json').exists():
         old = json.loads((out_dir / 'summary.json').read_text()).get('meta', {})
@@ -791,11 +814,12 @@ def merge(out_dir, sources, threshold=THRESHOLD) -> dict:
     (scored again) or a summary.json (its scored cases, kept: a part whose cases are gone). The parts
     must be one seed's draw identified by one code, scored at ``threshold``, each case in one part only."""
     cases: dict[str, dict] = {}
-    seeds, commits = set(), set()
+    seeds, commits, machines = set(), set(), []
     for src in map(Path, sources):
         rows, meta = part_rows(src, threshold)
         seeds.add(meta.get('seed'))
         commits.add(meta.get('commit'))
+        machines += [m for m in meta.get('machines', [meta.get('machine')]) if m and m not in machines]
         for c in rows:
             if c['case'] in cases:
                 raise SystemExit(f'--merge: {c["case"]} is in two parts (the second: {src})')
@@ -805,7 +829,8 @@ def merge(out_dir, sources, threshold=THRESHOLD) -> dict:
                          f'{sorted(map(str, commits))}; one summary is one code\'s answers to one draw')
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    meta = dict(seed=seeds.pop(), commit=commits.pop(), merged=[str(s) for s in sources])
+    meta = dict(seed=seeds.pop(), commit=commits.pop(), merged=[str(s) for s in sources],
+                machines=machines)      # where known: a balancing loop's draw is its machine's (data_digest)
     return write_summary(out_dir, [cases[k] for k in sorted(cases)], threshold, meta)
 
 

@@ -13,6 +13,7 @@ run (what CI runs) identifies IN_SUITE, three cart records (a balancing loop's o
 pendulum's identification takes minutes: the others are marked long; ``-m long`` runs them). The whole draw
 (hundreds of cases, each as long as drawn) is ``python -m bench.ident_campaign``.
 """
+import hashlib
 import json
 import math
 from concurrent.futures import ThreadPoolExecutor
@@ -590,6 +591,10 @@ def test_resume_keeps_the_cases_of_this_code_and_refuses_another_code_or_draw(tm
     s = scorer.run_campaign(out, 0, SEED, indices=[2], resume=True, with_oracle=False)
     assert s['outcomes'] == {'error': 1}
     assert s['meta']['resumed_cases'] == 1 and s['meta']['commit'] == 'abc1234'
+    # the row names the draw it scored (a balancing loop's bytes differ between machines), the meta the machine
+    data = (out / 'cases' / 'case0002' / 'data.csv').read_bytes()
+    assert s['cases'][0]['data_sha256'] == hashlib.sha256(data).hexdigest()
+    assert s['meta']['machine']['arch'] and s['meta']['machine']['numpy'] == np.__version__
     assert not (ident / 'stderr.txt').exists()          # identify_case never ran
     assert 'code abc1234' in (out / 'summary.md').read_text()
     (out / 'summary.json').unlink()                     # stopped before its summary: rescored from the cases
@@ -623,6 +628,7 @@ def test_merge_joins_parts_of_one_campaign_and_refuses_others(tmp_path, monkeypa
     s = scorer.merge(tmp_path / 'all', [tmp_path / 'a', tmp_path / 'b' / 'summary.json'])
     assert [c['case'] for c in s['cases']] == ['case0002', 'case0003']
     assert s['meta']['seed'] == SEED and s['meta']['commit'] == 'abc1234' and s['n_cases'] == 2
+    assert s['meta']['machines'] == [scorer.machine()]        # both parts ran here
     assert '2 cases' in (tmp_path / 'all' / 'summary.md').read_text()
     # a campaign kept as that summary goes on with the cases it does not hold
     assert scorer.not_held(range(5), [tmp_path / 'all' / 'summary.json'], SEED) == [0, 1, 4]
