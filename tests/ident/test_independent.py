@@ -70,7 +70,7 @@ def data(tmp_path_factory):
 
 #: the cases of the default run (a clean record and an effect for the closed loop, a clean cart); the others
 #: are marked long (the default run's campaign cases cover an offset and a spring on other rigs:
-#: tests/ident/test_campaign.py)
+#: tests/ident/test_campaign_fixed.py)
 IN_SUITE = ('cart_none', 'loop_none', 'loop_delay')
 
 
@@ -275,7 +275,7 @@ def test_drive_play_found_sized_and_exported(data, tmp_path, capsys):
     assert truth.drive_damping_Ns_per_m == pytest.approx(final['drive_damping_Ns_per_m']['value'])
 
 
-@pytest.mark.long     # the default run's campaign cases are other rigs, with overruns (tests/ident/test_campaign.py)
+@pytest.mark.long     # the default run's campaign cases: other rigs, with overruns (test_campaign_fixed.py)
 def test_other_rig_with_overruns_and_5ms_sampling_stays_plausible(data, tmp_path, capsys):
     """ip02: lighter cart, other motor; its plant file declares only the plant (the paper's
     friction is the hypothesis). The refit friction is that rig's, nothing is added, the
