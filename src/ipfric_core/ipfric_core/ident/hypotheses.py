@@ -441,9 +441,8 @@ def screen(hs: list[Hypothesis], short: list[tuple[Model, float]], pe: Problem, 
     with the friction levels free is measured by what it adds to the refit's short fit (the refit's gain it takes
     for free; :func:`beyond_refit` judges them so); the others by their gain over ``current``. A short fit the data
     already contradict (:func:`contradictions`) is refused here and takes no place in its group, except a kept
-    effect's refinement, whose full fit the same checks judge (seed 2027's case 138 drawn on an AMD EPYC, a 0.40 mm
-    drive play in a balancing loop at 5.7 ms: every start's short fit of the opened play crossed it between two
-    readings, the true play in two; fitted in full, 0.38 mm and 3.19 counts on validation against 29.1). A hypothesis is
+    effect's refinement, whose full fit the same checks judge (a drive's opened play: docs/identification.md,
+    seed 2027's case 138). A hypothesis is
     fitted in full when its gain reaches SCREEN_GAIN and FULL_SHARE of the best of its group's, and it is among the
     FULL_TOP best of it. The plant corrections (two at most) take no place in the ranks and do not set the bar: each
     is fitted in full when its gain beyond the refit reaches FULL_SHARE of the best effect's. Measured over
