@@ -246,6 +246,39 @@ def test_a_deadzone_counts_by_what_a_friction_level_cannot_take_over():
     assert scorer.components(dz(31.5, 49.0))[0]['counts'] == 31.5
 
 
+def test_an_offset_names_a_springs_preload_and_is_no_wrong_name():
+    truth = {'effects': {'spring': {'library': False, 'contribution_counts_rms': 15.5, 'preload_N': 0.00345,
+                                    'preload_contribution_counts_rms': 4.4}},
+             'plant_error': {'name': 'alpha', 'factor': 0.69, 'contribution_counts_rms': 361.0}}
+    exp = scorer.expected_answer(truth, 2.0)
+    assert exp['label'] == 'alpha corrected' and exp['preload_N'] == 0.00345   # naming the preload is not required
+
+    def answer(offset, corrected=('alpha',)):
+        return {'effects_added': ['offset'], 'constants_corrected': list(corrected), 'verdict': {'explained': False},
+                'ladder': [{'params': [{'name': 'offset_N', 'value': offset, 'fitted': True}]}]}
+    assert scorer.outcome(exp, scorer.predicted_answer(answer(0.00338))) == 'correct'      # seed 2027, case 38
+    assert scorer.outcome(exp, scorer.predicted_answer(answer(-0.00338))) == 'partial'     # not the preload
+    assert scorer.outcome(exp, scorer.predicted_answer(answer(0.0075))) == 'partial'       # beyond a factor 2
+    alone = {'effects': {'spring': dict(truth['effects']['spring'], contribution_counts_rms=166.0)},
+             'plant_error': None}
+    exp = scorer.expected_answer(alone, 2.0)
+    assert exp['label'] == 'not_explained'
+    assert scorer.outcome(exp, scorer.predicted_answer(answer(0.004, ()))) == 'correct'
+    assert scorer.outcome(exp, scorer.predicted_answer(answer(-0.004, ()))) == 'wrong'
+    unseen = {'effects': {'spring': dict(alone['effects']['spring'], preload_contribution_counts_rms=1.9)},
+              'plant_error': None}
+    assert scorer.outcome(scorer.expected_answer(unseen, 2.0), scorer.predicted_answer(answer(0.004, ()))) == 'wrong'
+
+
+def test_the_generator_parts_a_spring_into_its_pull_and_its_preload():
+    """Seed 2027, case 38, 20 s: a cable of 0.07 N/m with a preload of 0.0035 N on a cart whose friction is
+    0.23 N."""
+    _, truth = campaign.make_case(2027, 38, duration=20.0)
+    q = truth['effects']['spring']
+    assert q['preload_N'] == pytest.approx(0.00345, rel=0.01)
+    assert 0.5 < q['preload_contribution_counts_rms'] < q['contribution_counts_rms']
+
+
 @pytest.mark.parametrize('seed, index, play_max', [(2026, 42, 6.0)])
 def test_the_generator_parts_a_drive_into_its_play_and_its_mass(seed, index, play_max):
     """Case 42 of seed 2026: a 0.21 mm play with a motor side of a quarter of the cart's mass; the

@@ -46,7 +46,8 @@ Parts of an effect that a declared parameter takes over: a drive's play alone
 (``play_contribution_counts_rms``: against its motor side fixed to the cart, a heavier cart;
 ``closed_contribution_counts_rms``: against the same drive with its play closed, a compliant contact) and a
 deadzone beyond the friction (``beyond_friction_counts_rms``: against a Coulomb and static level
-higher by alpha dz, what the deadzone is while the cart moves the way it is driven).
+higher by alpha dz, what the deadzone is while the cart moves the way it is driven). A spring's
+preload is a constant force (``preload_contribution_counts_rms``: against the same spring without it).
 
 Contribution of an effect (truth ``contribution_counts_rms``): the recorded command is replayed
 from the true state at the start of each 1 s window (multiple shooting), once with every drawn
@@ -876,6 +877,13 @@ def contributions(spec, data):
             d = (x_with - _replay(t, volt, Y, ST, starts, p2, inp2, presc, hmax)) / rig["x_res"]
             a, b, _ = rms(d)
             out[name].update(closed_contribution_counts_rms=a, closed_contribution_counts_rms_validation=b)
+        if name == "spring" and full[name]["preload_N"] != 0.0:
+            # its preload's part: a constant force along the track (an offset); the spring without it
+            unloaded = dict(full, spring=dict(full[name], preload_N=0.0))
+            p2, inp2 = _pvec(spec, unloaded)
+            d = (x_with - _replay(t, volt, Y, ST, starts, p2, inp2, presc, hmax)) / rig["x_res"]
+            a, b, _ = rms(d)
+            out[name].update(preload_contribution_counts_rms=a, preload_contribution_counts_rms_validation=b)
     pe = spec.get("plant_error")
     if pe is not None:
         wrong = dict(rig, **{pe["name"]: pe["declared"]})
