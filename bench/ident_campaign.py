@@ -7,6 +7,8 @@ that shares nothing with ipfric_core), each identified by ``ipfric identify`` an
     python -m bench.ident_campaign --out runs/all --merge runs/part1 runs/part2/summary.json   # one summary
     python -m bench.ident_campaign --out runs/rest --cases 200 --seed 2027 --except bench/campaign/seed2027.json
                                                   # the cases a kept part does not hold (same code)
+    python -m bench.ident_campaign --out runs/now --newest bench/campaign/seed2027-*.json
+                                                  # each case's newest answer over parts of several codes
 
 A case's expected answer: the library effect(s) whose own contribution (truth
 ``contribution_counts_rms``: multiple shooting on 1 s windows, cart encoder counts; angle counts
@@ -398,14 +400,16 @@ def data_digest(case_dir: Path) -> str:
 
 
 def machine() -> dict:
-    """The machine a part ran on (its processor and numpy's SIMD paths): what a balancing loop's draw
-    depends on (:func:`data_digest`)."""
-    from numpy._core._multiarray_umath import __cpu_features__ as features
+    """The machine a part ran on (its processor and its vector extensions, named as numpy names them: AVX2,
+    FMA3): what a balancing loop's draw depends on (:func:`data_digest`)."""
     info = Path('/proc/cpuinfo')
-    cpu = next((ln.split(':', 1)[1].strip() for ln in info.read_text().splitlines() if ln.startswith('model name')),
-               '') if info.exists() else ''
-    return dict(cpu=cpu or platform.processor(), arch=platform.machine(), numpy=np.__version__,
-                simd=sorted(k for k, v in features.items() if v and k.startswith(('AVX', 'FMA'))))
+    lines = info.read_text().splitlines() if info.exists() else []
+
+    def field(name: str) -> str:
+        return next((ln.split(':', 1)[1].strip() for ln in lines if ln.split(':', 1)[0].strip() == name), '')
+    simd = {'FMA3' if f == 'fma' else f.upper() for f in field('flags').split() if f.startswith(('avx', 'fma'))}
+    return dict(cpu=field('model name') or platform.processor(), arch=platform.machine(), numpy=np.__version__,
+                simd=sorted(simd))
 
 
 #: the ladder's law that is the generator's (the exponential Stribeck curve, gamma 2): the friction levels of a
@@ -866,6 +870,41 @@ def merge(out_dir, sources, threshold=THRESHOLD) -> dict:
     return write_summary(out_dir, [cases[k] for k in sorted(cases)], threshold, meta)
 
 
+def commit_time(commit: str) -> int:
+    """The commit time [s since 1970] of ``commit`` in this repository (a part's code)."""
+    try:
+        return int(subprocess.run(['git', 'log', '-1', '--format=%ct', commit], cwd=ROOT, capture_output=True,
+                                  text=True, check=True).stdout.strip())
+    except (OSError, subprocess.CalledProcessError, ValueError):
+        raise SystemExit(f'--newest: the code {commit!r} of a part is not a commit of this repository') from None
+
+
+def newest(out_dir, sources, threshold=THRESHOLD) -> dict:
+    """One summary of each case's newest answer over parts of one seed's draw identified by several codes:
+    the parts taken in the order of their code's commit time, a case's row from the last part that holds it
+    (what the campaign's code answers today where it was run again, its older code's answer where not)."""
+    parts = []
+    for src in map(Path, sources):
+        rows, meta = part_rows(src, threshold)
+        commit = str(meta.get('commit', ''))
+        if not commit or commit.endswith('+dirty') or commit == 'unknown':
+            raise SystemExit(f'--newest: {src} holds the answers of code {commit!r}, not of a commit')
+        parts.append((commit_time(commit), str(src), rows, meta))
+    parts.sort(key=lambda q: q[:2])
+    seeds = {meta.get('seed') for *_, meta in parts}
+    if len(seeds) != 1:
+        raise SystemExit(f'--newest: the parts are draws of seeds {sorted(map(str, seeds))}; one summary is one draw')
+    cases = {c['case']: dict(c, code=meta['commit']) for *_, rows, meta in parts for c in rows}
+    machines: list = []
+    for *_, meta in parts:
+        machines += [m for m in meta.get('machines', [meta.get('machine')]) if m and m not in machines]
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    meta = dict(seed=seeds.pop(), commit='newest of ' + ', '.join(m['commit'] for *_, m in parts),
+                newest=[src for _, src, _, _ in parts], machines=machines)
+    return write_summary(out_dir, [cases[k] for k in sorted(cases)], threshold, meta)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     ap.add_argument('--out', required=True)
@@ -884,9 +923,14 @@ def main(argv=None) -> int:
     ap.add_argument('--except', dest='skip', nargs='+', metavar='PART', default=[],
                     help='leave out the cases these parts (directories or summary.json) already hold: a campaign '
                          'kept in bench/campaign/ goes on with the rest')
+    ap.add_argument('--newest', nargs='+', metavar='PART',
+                    help="write one summary into --out of each case's newest answer over these parts of one draw "
+                         "(directories or summary.json; their codes ordered by commit time)")
     a = ap.parse_args(argv)
     if a.merge:
         s = merge(a.out, a.merge, a.threshold)
+    elif a.newest:
+        s = newest(a.out, a.newest, a.threshold)
     elif a.rescore:
         s = rescore(a.out, a.threshold, not a.no_oracle)
     else:

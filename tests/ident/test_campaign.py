@@ -352,7 +352,8 @@ def test_resume_keeps_the_cases_of_this_code_and_refuses_another_code_or_draw(tm
 def test_merge_joins_parts_of_one_campaign_and_refuses_others(tmp_path, monkeypatch):
     """--merge writes one summary of a campaign run in parts: a directory's cases scored again and a
     summary.json's scored cases (a part whose case files are gone); a case in two parts, parts of two
-    codes or scored at another threshold are refused."""
+    codes or scored at another threshold are refused. --newest joins parts of several codes, each case's row
+    from the newest code."""
     monkeypatch.setattr(scorer, 'code_commit', lambda: 'abc1234')
     for part, index in (('a', 2), ('b', 3)):
         out = tmp_path / part
@@ -385,3 +386,23 @@ def test_merge_joins_parts_of_one_campaign_and_refuses_others(tmp_path, monkeypa
     (tmp_path / 'b' / 'summary.json').write_text(json.dumps(other))
     with pytest.raises(SystemExit, match="codes \\['abc1234', 'def5678'\\]"):
         scorer.merge(tmp_path / 'x', [tmp_path / 'a', tmp_path / 'b' / 'summary.json'])
+    # each case's newest answer over parts of several codes: the parts in the order of their codes' commits
+    older = json.loads((tmp_path / 'all' / 'summary.json').read_text())
+    older['meta']['commit'] = 'abc1234'
+    newer = dict(other, cases=[dict(c, outcome='correct', predicted='none') for c in other['cases']])
+    (tmp_path / 'old.json').write_text(json.dumps(older))
+    (tmp_path / 'new.json').write_text(json.dumps(newer))
+    monkeypatch.setattr(scorer, 'commit_time', {'abc1234': 100, 'def5678': 200}.get)
+    for order in ([tmp_path / 'new.json', tmp_path / 'old.json'], [tmp_path / 'old.json', tmp_path / 'new.json']):
+        s = scorer.newest(tmp_path / 'now', order)
+        assert {c['case']: (c['code'], c['outcome']) for c in s['cases']} == {
+            'case0002': ('abc1234', 'error'), 'case0003': ('def5678', 'correct')}
+        assert s['meta']['commit'] == 'newest of abc1234, def5678'
+    older['meta']['seed'] = SEED + 1
+    (tmp_path / 'old.json').write_text(json.dumps(older))
+    with pytest.raises(SystemExit, match='draws of seeds'):
+        scorer.newest(tmp_path / 'now', [tmp_path / 'old.json', tmp_path / 'new.json'])
+    newer['meta']['commit'] = 'def5678+dirty'
+    (tmp_path / 'new.json').write_text(json.dumps(newer))
+    with pytest.raises(SystemExit, match="code 'def5678\\+dirty', not of a commit"):
+        scorer.newest(tmp_path / 'now', [tmp_path / 'new.json'])
