@@ -148,10 +148,14 @@ def expected_answer(truth: dict, threshold: float = THRESHOLD) -> dict:
     # the other names of a library answer (a drive below the encoder's play: its play closed)
     alike = {n: c['name'] for c in seen if c['library'] and c['counts'] >= threshold for n in c.get('alike', ())}
     preload = [c['preload_N'] for c in comps if 'preload_N' in c]
+    # one correction that replays every discrepancy from outside the library within the threshold (a wrong
+    # pendulum mass with what else is outside: truth ``one_correction_counts_rms``) is another name of them
+    nearest = (truth.get('plant_error') or {}).get('one_correction_counts_rms') or {}
+    single = sorted(n for n, c in nearest.items() if c < threshold) if not above else []
     return dict(label=label, library=above, outside=outside, below=below, alike=alike,
                 same_as=same[0] if not above and len(same) == 1 else [],
                 clean=not comps, pendulum=truth.get('pendulum_attached', True),
-                preload_N=preload[0] if preload else None)
+                preload_N=preload[0] if preload else None, single=single)
 
 
 def predicted_answer(result: dict | None) -> dict:
@@ -225,7 +229,8 @@ def named_kinds(expected: dict, added: list) -> list[str]:
 def outcome(expected: dict, predicted: dict) -> str:
     """correct | alike (an effect that acts alike named: :data:`ALIKE`; a drive below the encoder's play
     named with its play closed, :data:`CLOSED_DRIVE`; or, for a wrong constant, the
-    corrections that are the same model: :data:`SCALED`) | acceptable (below threshold) | partial |
+    corrections that are the same model: :data:`SCALED`, or the one correction that replays it and every
+    other discrepancy from outside the library within the threshold) | acceptable (below threshold) | partial |
     false_positive | missed | wrong | error. An offset that names a spring's preload is set aside
     (:func:`preload_named`)."""
     predicted = preload_named(expected, predicted)
@@ -245,6 +250,8 @@ def outcome(expected: dict, predicted: dict) -> str:
         return 'wrong'
     if e == 'not_explained':
         if expected.get('same_as') and sorted(predicted['added']) == expected['same_as']:
+            return 'alike'
+        if len(predicted['added']) == 1 and predicted['added'][0] in expected.get('single', ()):
             return 'alike'
         return 'missed' if p == 'none' else 'wrong'
     if p in ('none', 'not_explained'):

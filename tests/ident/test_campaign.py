@@ -270,6 +270,36 @@ def test_an_offset_names_a_springs_preload_and_is_no_wrong_name():
     assert scorer.outcome(scorer.expected_answer(unseen, 2.0), scorer.predicted_answer(answer(0.004, ()))) == 'wrong'
 
 
+def test_one_correction_that_replays_what_is_outside_the_library_is_another_name_of_it():
+    """Seed 2027's case 123: a pendulum mass declared 0.71 times its value beside a 3.5-count spring in a balancing
+    loop; one correction of alpha (or of M) replays both within 1.1 counts, and the identification answered
+    alpha corrected, explained to the floor."""
+    truth = _truth((('spring', 3.5),), {'name': 'm', 'factor': 0.71, 'contribution_counts_rms': 11.9,
+                                       'one_correction_counts_rms': {'alpha corrected': 1.09, 'M corrected': 1.16}})
+    exp = scorer.expected_answer(truth, 2.0)
+    assert exp['label'] == 'not_explained' and exp['single'] == ['M corrected', 'alpha corrected']
+
+    def answer(*corrected, explained=True):
+        return {'effects_added': [], 'constants_corrected': list(corrected), 'verdict': {'explained': explained}}
+    assert scorer.outcome(exp, scorer.predicted_answer(answer('alpha'))) == 'alike'
+    assert scorer.outcome(exp, scorer.predicted_answer(answer('M'))) == 'alike'
+    assert scorer.outcome(exp, scorer.predicted_answer(answer(explained=False))) == 'correct'
+    assert scorer.outcome(exp, scorer.predicted_answer(answer())) == 'missed'
+    # one that leaves more than the threshold is a wrong name (case 55: 71 counts left by alpha alone)
+    truth['plant_error']['one_correction_counts_rms'] = {'alpha corrected': 71.2, 'M corrected': 86.6}
+    assert scorer.outcome(scorer.expected_answer(truth, 2.0), scorer.predicted_answer(answer('alpha'))) == 'wrong'
+
+
+def test_the_generator_measures_what_one_correction_leaves_of_a_wrong_pendulum_mass():
+    """Seed 2027, 20 s: case 123 (m declared 0.71 times, a spring beside it) is replayed by one correction within
+    the threshold; case 55 (m declared 0.80 times, the pendulum hanging) needs both."""
+    for index, least, most in ((123, 0.0, 2.0), (55, 20.0, 200.0)):
+        _, truth = campaign.make_case(2027, index, duration=20.0)
+        left = truth['plant_error']['one_correction_counts_rms']
+        assert set(left) == {'alpha corrected', 'M corrected'}
+        assert least < min(left.values()) < most, (index, left)
+
+
 def test_the_generator_parts_a_spring_into_its_pull_and_its_preload():
     """Seed 2027, case 38, 20 s: a cable of 0.07 N/m with a preload of 0.0035 N on a cart whose friction is
     0.23 N."""

@@ -59,7 +59,8 @@ the true motion (about 1e-3 count; larger only where the motion is chaotic, e.g.
 contact knocked at every reversal of a balancing controller). sensor_bias: the difference of
 the angle readings, in angle counts.
 A declared plant constant made wrong (``plant_error``) gets its contribution the same way (the
-declared constant against the true one).
+declared constant against the true one); a wrong pendulum mass also what one correction of the plant
+leaves of everything outside the library (``one_correction_counts_rms``: the best alpha, the best M).
 
 What is drawn (per case): the experiment (cart alone 50 %: ramps, steps with coast-downs,
 repositioning moves, pulses, multisines, no theta column or in 30 % a column of literal zeros;
@@ -98,6 +99,7 @@ from pathlib import Path
 
 import numba
 import numpy as np
+from scipy.optimize import minimize_scalar
 
 from . import rigsim
 
@@ -110,6 +112,7 @@ FALLEN = 0.5236         # |theta| from upright beyond which a balancing run has 
 SUBSTEP = 1e-4          # largest internal step [s]
 WINDOW = 1.0            # multiple-shooting window of the contributions [s]
 MAX_ATTEMPTS = 12
+NEAREST_SCALE = (0.5, 2.0)   # the mass scales searched for the model one correction leaves (one_correction)
 
 LIBRARY = ("deadzone", "saturation", "delay", "cogging", "asymmetry", "offset", "sensor_bias",
            "drive_backlash")
@@ -892,7 +895,28 @@ def contributions(spec, data):
         a, b, mx = rms(d)
         out["plant_error"] = dict(contribution_counts_rms=a, contribution_counts_rms_validation=b,
                                   contribution_counts_max=mx, unit="cart counts")
+        if pe["name"] == "m" and presc:
+            out["plant_error"]["one_correction_counts_rms"] = one_correction(spec, data, x_with, starts, pe)
     return out
+
+
+def one_correction(spec, data, x_with, starts, pe):
+    """What one correction of the declared plant leaves of everything the library does not hold in a case with
+    a wrong pendulum mass (m declared f times; the pair M and alpha by f is the rig): the replay with every
+    drawn effect against the declared rig without the effects from outside the library, with one correction,
+    the best of a bounded search (NEAREST_SCALE). ``alpha corrected``: every force scaled by one factor, which
+    is both masses scaled by its inverse; ``M corrected``: the cart's mass alone. RMS cart counts."""
+    t, volt, Y, ST = data["t"], data["voltage"], data["Y"], data["ST"]
+    rig, hmax = spec["rig"], _hmax(spec)
+    inside = {k: v for k, v in data["effects"].items() if k not in OUTSIDE}
+
+    def left(s, scaled):
+        p2, inp2 = _pvec(spec, inside, dict(rig, M=s * rig["M"], m=pe["declared"] * (s if scaled else 1.0)))
+        d = (x_with - _replay(t, volt, Y, ST, starts, p2, inp2, True, hmax)) / rig["x_res"]
+        return float(np.sqrt(np.mean(d ** 2)))
+    return {name: float(minimize_scalar(left, bounds=NEAREST_SCALE, args=(scaled,), method="bounded",
+                                        options={"xatol": 1e-4}).fun)
+            for name, scaled in (("alpha corrected", True), ("M corrected", False))}
 
 
 def _jsonable(o):
