@@ -246,27 +246,32 @@ def test_a_deadzone_counts_by_what_a_friction_level_cannot_take_over():
     assert scorer.components(dz(31.5, 49.0))[0]['counts'] == 31.5
 
 
-def test_an_offset_names_a_springs_preload_and_is_no_wrong_name():
-    truth = {'effects': {'spring': {'library': False, 'contribution_counts_rms': 15.5, 'preload_N': 0.00345,
-                                    'preload_contribution_counts_rms': 4.4}},
-             'plant_error': {'name': 'alpha', 'factor': 0.69, 'contribution_counts_rms': 361.0}}
-    exp = scorer.expected_answer(truth, 2.0)
-    assert exp['label'] == 'alpha corrected' and exp['preload_N'] == 0.00345   # naming the preload is not required
+def test_an_offset_names_a_springs_mean_pull_and_is_no_wrong_name():
+    def spring(whole, pull=0.0034, part=4.4, library=None):
+        effects = {'spring': {'library': False, 'contribution_counts_rms': whole, 'mean_pull_N': pull,
+                              'preload_N': 0.00345, 'k_N_per_m': 0.07, 'mean_pull_contribution_counts_rms': part}}
+        effects.update({k: {'library': True, 'contribution_counts_rms': v} for k, v in (library or {}).items()})
+        return {'effects': effects, 'plant_error': {'name': 'alpha', 'factor': 0.69, 'contribution_counts_rms': 361.0}}
 
-    def answer(offset, corrected=('alpha',)):
-        return {'effects_added': ['offset'], 'constants_corrected': list(corrected), 'verdict': {'explained': False},
+    def answer(offset, corrected=('alpha',), effects=('offset',)):
+        return {'effects_added': list(effects), 'constants_corrected': list(corrected), 'verdict': {'explained': False},
                 'ladder': [{'params': [{'name': 'offset_N', 'value': offset, 'fitted': True}]}]}
+    exp = scorer.expected_answer(spring(15.5), 2.0)
+    assert exp['label'] == 'alpha corrected' and exp['pull_N'] == 0.0034      # naming the pull is not required
     assert scorer.outcome(exp, scorer.predicted_answer(answer(0.00338))) == 'correct'      # seed 2027, case 38
-    assert scorer.outcome(exp, scorer.predicted_answer(answer(-0.00338))) == 'partial'     # not the preload
+    assert scorer.outcome(exp, scorer.predicted_answer(answer(-0.00338))) == 'partial'     # not the pull
     assert scorer.outcome(exp, scorer.predicted_answer(answer(0.0075))) == 'partial'       # beyond a factor 2
-    alone = {'effects': {'spring': dict(truth['effects']['spring'], contribution_counts_rms=166.0)},
-             'plant_error': None}
+    assert scorer.outcome(exp, scorer.predicted_answer(answer(0.0015))) == 'partial'       # below half of it
+    # an offset the library expects beside the spring is that offset, not the pull set aside
+    both = scorer.expected_answer(spring(15.5, library={'offset': 40.0}), 2.0)
+    assert scorer.outcome(both, scorer.predicted_answer(answer(0.0034))) == 'correct'
+    assert scorer.outcome(both, scorer.predicted_answer(answer(0.0034, effects=()))) == 'partial'
+    alone = dict(spring(166.0), plant_error=None)
     exp = scorer.expected_answer(alone, 2.0)
     assert exp['label'] == 'not_explained'
     assert scorer.outcome(exp, scorer.predicted_answer(answer(0.004, ()))) == 'correct'
     assert scorer.outcome(exp, scorer.predicted_answer(answer(-0.004, ()))) == 'wrong'
-    unseen = {'effects': {'spring': dict(alone['effects']['spring'], preload_contribution_counts_rms=1.9)},
-              'plant_error': None}
+    unseen = dict(spring(166.0, part=1.9), plant_error=None)
     assert scorer.outcome(scorer.expected_answer(unseen, 2.0), scorer.predicted_answer(answer(0.004, ()))) == 'wrong'
 
 
@@ -283,6 +288,10 @@ def test_one_correction_that_replays_what_is_outside_the_library_is_another_name
         return {'effects_added': [], 'constants_corrected': list(corrected), 'verdict': {'explained': explained}}
     assert scorer.outcome(exp, scorer.predicted_answer(answer('alpha'))) == 'alike'
     assert scorer.outcome(exp, scorer.predicted_answer(answer('M'))) == 'alike'
+    assert scorer.outcome(exp, scorer.predicted_answer(answer('M', 'alpha'))) == 'alike'   # holds either
+    truth['plant_error']['one_correction_counts_rms']['M corrected'] = 5.0
+    assert scorer.outcome(scorer.expected_answer(truth, 2.0), scorer.predicted_answer(answer('M'))) == 'wrong'
+    assert scorer.outcome(scorer.expected_answer(truth, 2.0), scorer.predicted_answer(answer('M', 'alpha'))) == 'alike'
     assert scorer.outcome(exp, scorer.predicted_answer(answer(explained=False))) == 'correct'
     assert scorer.outcome(exp, scorer.predicted_answer(answer())) == 'missed'
     # one that leaves more than the threshold is a wrong name (case 55: 71 counts left by alpha alone)
@@ -297,16 +306,21 @@ def test_the_generator_measures_what_one_correction_leaves_of_a_wrong_pendulum_m
         _, truth = campaign.make_case(2027, index, duration=20.0)
         left = truth['plant_error']['one_correction_counts_rms']
         assert set(left) == {'alpha corrected', 'M corrected'}
-        assert least < min(left.values()) < most, (index, left)
+        for name, counts in left.items():
+            assert least < counts < most, (index, name, counts)
 
 
-def test_the_generator_parts_a_spring_into_its_pull_and_its_preload():
+def test_the_generator_parts_a_spring_into_its_pull_along_the_track_and_its_mean_pull():
     """Seed 2027, case 38, 20 s: a cable of 0.07 N/m with a preload of 0.0035 N on a cart whose friction is
-    0.23 N."""
+    0.23 N; over its first 20 s the cart stands 39 mm left of the centre on average, so the cable's mean pull
+    is 0.0062 N (over the whole 54.5 s it stands 8 mm right of it: 0.0029 N)."""
     _, truth = campaign.make_case(2027, 38, duration=20.0)
     q = truth['effects']['spring']
     assert q['preload_N'] == pytest.approx(0.00345, rel=0.01)
-    assert 0.5 < q['preload_contribution_counts_rms'] < q['contribution_counts_rms']
+    assert q['mean_pull_N'] == pytest.approx(q['preload_N'] - q['k_N_per_m'] * truth['motion']['mean_x_m'])
+    assert truth['motion']['mean_x_m'] == pytest.approx(-0.039, abs=0.002)
+    assert q['mean_pull_N'] == pytest.approx(0.0062, abs=0.0002)
+    assert 0.1 < q['mean_pull_contribution_counts_rms'] < q['contribution_counts_rms']
 
 
 @pytest.mark.parametrize('seed, index, play_max', [(2026, 42, 6.0)])

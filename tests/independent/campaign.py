@@ -47,7 +47,8 @@ Parts of an effect that a declared parameter takes over: a drive's play alone
 ``closed_contribution_counts_rms``: against the same drive with its play closed, a compliant contact) and a
 deadzone beyond the friction (``beyond_friction_counts_rms``: against a Coulomb and static level
 higher by alpha dz, what the deadzone is while the cart moves the way it is driven). A spring's
-preload is a constant force (``preload_contribution_counts_rms``: against the same spring without it).
+mean pull over the record (``mean_pull_N``, F_pre - k mean(x)) is a constant force
+(``mean_pull_contribution_counts_rms``: against the same spring without it).
 
 Contribution of an effect (truth ``contribution_counts_rms``): the recorded command is replayed
 from the true state at the start of each 1 s window (multiple shooting), once with every drawn
@@ -880,13 +881,15 @@ def contributions(spec, data):
             d = (x_with - _replay(t, volt, Y, ST, starts, p2, inp2, presc, hmax)) / rig["x_res"]
             a, b, _ = rms(d)
             out[name].update(closed_contribution_counts_rms=a, closed_contribution_counts_rms_validation=b)
-        if name == "spring" and full[name]["preload_N"] != 0.0:
-            # its preload's part: a constant force along the track (an offset); the spring without it
-            unloaded = dict(full, spring=dict(full[name], preload_N=0.0))
-            p2, inp2 = _pvec(spec, unloaded)
+        if name == "spring":
+            # its mean pull over the record, F_pre - k mean(x): a constant force (an offset); the spring without it
+            q = full[name]
+            pull = q["preload_N"] - q["k_N_per_m"] * float(np.mean(Y[:, 0]))
+            p2, inp2 = _pvec(spec, dict(full, spring=dict(q, preload_N=q["preload_N"] - pull)))
             d = (x_with - _replay(t, volt, Y, ST, starts, p2, inp2, presc, hmax)) / rig["x_res"]
             a, b, _ = rms(d)
-            out[name].update(preload_contribution_counts_rms=a, preload_contribution_counts_rms_validation=b)
+            out[name].update(mean_pull_N=pull, mean_pull_contribution_counts_rms=a,
+                             mean_pull_contribution_counts_rms_validation=b)
     pe = spec.get("plant_error")
     if pe is not None:
         wrong = dict(rig, **{pe["name"]: pe["declared"]})
@@ -977,6 +980,7 @@ def make_case(seed, index, duration=None):
         segments=data["meta"].get("segments"),
         voltage="command V as recorded (before delay, deadzone, saturation); held per sample",
         motion=dict(x_ptp_m=float(np.ptp(Y[:, 0])), max_abs_x_m=float(np.abs(Y[:, 0]).max()),
+                    mean_x_m=float(np.mean(Y[:, 0])),
                     max_speed_mps=float(np.abs(Y[:, 1]).max()),
                     theta_ptp_rad=float(np.ptp(Y[:, 2])) if spec["pendulum_attached"] else None),
         generator=f"tests/independent/campaign.py v{VERSION}")
