@@ -182,6 +182,12 @@ def answer_of(row: dict) -> dict:
     return dict(label=row['predicted'], added=row['added'], verdict=row['verdict'], offset_N=row.get('offset_N'))
 
 
+def not_explained(row: dict) -> bool:
+    """Whether a case's row says "not explained" once an offset naming a spring's mean pull is set aside
+    (:func:`pull_named`)."""
+    return pull_named(row['expected_detail'], answer_of(row))['label'] == 'not_explained'
+
+
 def answer_label(added: list, verdict) -> str:
     """The answer's name: the effects and corrections ``added``; without any, ``not_explained`` where the
     verdict says so, else ``none``."""
@@ -493,8 +499,7 @@ def summarize(cases: list[dict], threshold: float, meta: dict) -> dict:
                 pendulum = c['expected_detail'].get('pendulum', True)
                 ok = _kind(comp['name'], pendulum) in named_kinds(c['expected_detail'], c['added'])
             else:      # said not explained, or (the outside alone) answered with what is the same model
-                ok = pull_named(c['expected_detail'], answer_of(c))['label'] == 'not_explained' or \
-                    c['expected'] == 'not_explained' and c['outcome'] == 'alike'
+                ok = not_explained(c) or c['expected'] == 'not_explained' and c['outcome'] == 'alike'
             per_effect[comp['name']].append((comp['counts'], ok, c['predicted'], c['case']))
     rates = {}
     for name, pts in sorted(per_effect.items()):
@@ -554,13 +559,12 @@ def targets(s: dict) -> dict:
         comp['counts'] >= (limits.get(comp['name']) or s['threshold_counts'])
         for comp in c['components'] if comp['library'])]
     outside = [c for c in s['cases'] if c['expected'] == 'not_explained']
-    unexplained = [c for c in outside if pull_named(c['expected_detail'], answer_of(c))['label'] == 'not_explained']
     return dict(
         above_limit=len(above), right_above_limit=sum(c['outcome'] in ('correct', 'alike') for c in above),
         right_share_above_limit=(sum(c['outcome'] in ('correct', 'alike') for c in above) / len(above))
         if above else None,
         clean_share_anything_added=s['clean']['share_anything_added'],
-        outside=len(outside), outside_not_explained=len(unexplained),
+        outside=len(outside), outside_not_explained=sum(map(not_explained, outside)),
         outside_same_model=sum(c['outcome'] == 'alike' for c in outside),
         outside_under_library_name=sum(bool(c['added']) and c['outcome'] not in ('alike', 'correct') for c in outside))
 
@@ -862,17 +866,25 @@ def not_held(indices, parts, seed, threshold=THRESHOLD) -> list[int]:
     return left
 
 
+def machines_of(metas) -> list:
+    """The machines the parts of ``metas`` ran on (a part's ``machine``, a merge's ``machines``), each once."""
+    out: list = []
+    for meta in metas:
+        out += [m for m in meta.get('machines', [meta.get('machine')]) if m and m not in out]
+    return out
+
+
 def merge(out_dir, sources, threshold=THRESHOLD) -> dict:
     """One summary of the cases of several parts of one campaign: each source a campaign directory
     (scored again) or a summary.json (its scored cases, kept: a part whose cases are gone). The parts
     must be one seed's draw identified by one code, scored at ``threshold``, each case in one part only."""
     cases: dict[str, dict] = {}
-    seeds, commits, machines = set(), set(), []
+    seeds, commits, metas = set(), set(), []
     for src in map(Path, sources):
         rows, meta = part_rows(src, threshold)
         seeds.add(meta.get('seed'))
         commits.add(meta.get('commit'))
-        machines += [m for m in meta.get('machines', [meta.get('machine')]) if m and m not in machines]
+        metas.append(meta)
         for c in rows:
             if c['case'] in cases:
                 raise SystemExit(f'--merge: {c["case"]} is in two parts (the second: {src})')
@@ -883,7 +895,7 @@ def merge(out_dir, sources, threshold=THRESHOLD) -> dict:
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     meta = dict(seed=seeds.pop(), commit=commits.pop(), merged=[str(s) for s in sources],
-                machines=machines)      # where known: a balancing loop's draw is its machine's (data_digest)
+                machines=machines_of(metas))      # where known: a balancing loop's draw is its machine's (data_digest)
     return write_summary(out_dir, [cases[k] for k in sorted(cases)], threshold, meta)
 
 
@@ -912,13 +924,10 @@ def newest(out_dir, sources, threshold=THRESHOLD) -> dict:
     if len(seeds) != 1:
         raise SystemExit(f'--newest: the parts are draws of seeds {sorted(map(str, seeds))}; one summary is one draw')
     cases = {c['case']: dict(c, code=meta['commit']) for *_, rows, meta in parts for c in rows}
-    machines: list = []
-    for *_, meta in parts:
-        machines += [m for m in meta.get('machines', [meta.get('machine')]) if m and m not in machines]
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     meta = dict(seed=seeds.pop(), commit='newest of ' + ', '.join(m['commit'] for *_, m in parts),
-                newest=[src for _, src, _, _ in parts], machines=machines)
+                newest=[src for _, src, _, _ in parts], machines=machines_of(m for *_, m in parts))
     return write_summary(out_dir, [cases[k] for k in sorted(cases)], threshold, meta)
 
 
