@@ -2,7 +2,7 @@ import math
 
 import pytest
 
-from ipfric_core.physics.friction import Friction, static_friction, stribeck_level
+from ipfric_core.physics.friction import Friction, friction_vector, sliding_friction, static_friction, stribeck_level
 from ipfric_core.physics.params import FrictionParams
 
 FN = (0.815 + 0.21) * 9.8
@@ -57,6 +57,19 @@ def test_dynamic_steady_state_equals_exponential():
         z = f.level(v) * math.copysign(1, v) / 121.0
         assert f.z_rate(v, z) == pytest.approx(0.0, abs=1e-12)
         assert f.force(v, z) == pytest.approx(Friction(EXP, FN).force(v), rel=1e-12)
+
+
+def test_steady_sliding_friction_is_eq8_whatever_the_bristles_damping():
+    """The force of steady sliding (the report's friction at the speeds the cart moved at) is eq. (8) for the
+    dynamic law too: the bristles' damping sigma1 acts only while z moves. A real log's fit (sigma1 16686 N s/m)
+    was reported with 4249 N at 0.255 m/s, the bristles taken at rest (z = 0)."""
+    for sigma1 in (70.0, 16686.0):
+        fp = friction_vector(DYN.replace(sigma1=sigma1), FN)
+        for v in (0.00781, 0.0371, 0.255, -0.1):
+            g = (0.04287 + (0.0861 - 0.04287) * math.exp(-(abs(v) / 0.105) ** 2)) * FN
+            assert sliding_friction(fp, v) == pytest.approx(-math.copysign(g, v) - 3.0 * v, rel=1e-12)
+    fp = friction_vector(EXP, FN)
+    assert sliding_friction(fp, 0.05) == pytest.approx(Friction(EXP, FN).force(0.05), rel=1e-12)
 
 
 def test_dynamic_presliding_is_a_spring():

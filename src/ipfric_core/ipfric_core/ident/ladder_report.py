@@ -14,7 +14,7 @@ import numpy as np  # noqa: E402
 
 from ..analysis.plots import save_figure  # noqa: E402
 from ..analysis.records import smooth_rate  # noqa: E402
-from ..physics.friction import friction_force  # noqa: E402
+from ..physics.friction import sliding_friction  # noqa: E402
 from . import shooting  # noqa: E402
 from .effects import BASE_MODELS, PARAMS, static_level  # noqa: E402
 from .hypotheses import CORRECTABLE  # noqa: E402
@@ -114,7 +114,7 @@ def speeds(rec) -> dict:
 
 
 def friction_curve(step: Step, at: dict) -> list[dict]:
-    """The sliding friction [N] of the step's model (moving forward) at the speeds ``at`` (:func:`speeds`)
+    """The steady sliding friction [N] of the step's model (moving forward) at the speeds ``at`` (:func:`speeds`)
     with its standard error from the covariance of the fitted parameters (first order): where the
     cart never moves fast, these are what the data determine, not the law's parameters one by one."""
     errors: Any = step.std
@@ -128,7 +128,7 @@ def friction_curve(step: Step, at: dict) -> list[dict]:
     cov = errors.cov[np.ix_(index, index)]
 
     def force(model, v):
-        return -float(friction_force(model.vectors().fp, v, 0.0, 1.0))
+        return -float(sliding_friction(model.vectors().fp, v))
     out = []
     for key, v in at.items():
         f0 = force(step.model, v)

@@ -40,7 +40,7 @@ from .params import FrictionParams
 
 __all__ = ['DYNAMIC', 'FP_MODEL', 'FP_EPS', 'FP_SIGMA0', 'FP_SIGMA1', 'FP_ASYM', 'friction_vector', 'sticks',
            'static_limit', 'holding_margin', 'holds', 'sliding_level', 'bristle_level', 'friction_force',
-           'bristle_rate', 'friction_forces', 'bristle_path', 'Friction']
+           'steady_deflection', 'sliding_friction', 'bristle_rate', 'friction_forces', 'bristle_path', 'Friction']
 
 #: Codes of the friction models in a parameter vector (floats, so the vector is uniform).
 MODEL_CODES = {'viscous': 0.0, 'coulomb': 1.0, 'exponential': 2.0, 'dynamic': 3.0}
@@ -145,6 +145,22 @@ def friction_force(fp, v: float, z: float, direction: float) -> float:
     else:
         sign = math.copysign(1.0, v) if v != 0.0 else 0.0
     return -sliding_level(fp, v) * (sign + fp[FP_ASYM]) + viscous
+
+
+@compiled
+def steady_deflection(fp, v: float) -> float:
+    """The bristles' deflection [m] in steady sliding at ``v`` [m/s] (eq. 10 with z' = 0:
+    z = g(v) sgn(v) / sigma0); 0 for the laws without bristles."""
+    if fp[FP_MODEL] != DYNAMIC or v == 0.0:
+        return 0.0
+    return math.copysign(bristle_level(fp, v), v) / fp[FP_SIGMA0]
+
+
+@compiled
+def sliding_friction(fp, v: float) -> float:
+    """Friction force on the cart [N] in steady sliding at ``v`` [m/s] (eqs. 3, 6-8; for the dynamic law
+    eq. 11 at :func:`steady_deflection`, where the bristles' damping sigma1 no longer acts)."""
+    return friction_force(fp, v, steady_deflection(fp, v), 0.0)
 
 
 @compiled
