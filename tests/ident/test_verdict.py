@@ -1,5 +1,8 @@
 """The verdict (ident/judging.verdict) on a record of the independent simulator: the error left and what
 the encoders' rounding alone would leave, both in % of the measured motion."""
+from dataclasses import replace
+
+import numpy as np
 import pytest
 from independent import rigsim
 
@@ -44,3 +47,20 @@ def test_a_play_no_sensor_reads_does_not_raise_the_floor(tmp_path):
     closed = rounding_model(drive)
     assert closed['drive_backlash_m'] == 0.0 and closed['M'] == pytest.approx(model['M'] + 0.2)
     assert rounding_model(model) == model
+
+
+def test_a_validation_part_where_nothing_moves_judges_nothing(tmp_path):
+    """A cart standing still with no command in the validation part: the model replays it exactly (0 counts
+    left, 0 % of no motion), which explains nothing. The verdict says the data judge nothing and is not
+    "explained"; on the moving record it judges the cart."""
+    rec = load(rigsim.write_case('cart_none', tmp_path, duration=20.0), None)
+    val = rec.split(0.6)[1]
+    model = load_declared(None, 'exponential', pendulum=False)
+    moving = verdict(Problem(val), model)
+    assert moving['judged_on'] == ['x'] and moving['blocks']['x']['motion_counts'] > 100
+    still = replace(val, x=np.full_like(val.x, val.x[0]), u=np.zeros_like(val.u))
+    v = verdict(Problem(still), model)
+    assert v['blocks']['x']['motion_counts'] == 0.0 and v['unexplained_counts'] == pytest.approx(0.0, abs=1e-9)
+    assert v['judged_on'] == [] and not v['explained']
+    assert v['reason'].startswith('not judged: nothing moves by 2 counts RMS within the validation windows (the cart '
+                                  'moves 0 counts RMS')

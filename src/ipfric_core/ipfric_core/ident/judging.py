@@ -41,6 +41,11 @@ WORSE_COUNTS = 0.5       # and by more than this [counts RMS]: an angle error ne
 #: leaves, plus this many counts
 EXPLAINED_FACTOR = 1.5
 EXPLAINED_SLACK = 0.3
+#: a block of the validation data whose readings move less than this within its windows judges nothing [counts RMS]
+JUDGING_MOTION = 2.0
+NAMES = {'x': 'cart', 'theta': 'angle'}
+#: what the share left is of, by the block that judges
+OF = {'x': 'the motion', 'theta': "the angle's motion"}
 #: the effects with a state no sensor reads (a play's position), closed by their size at zero (:func:`rounding_model`)
 HIDDEN = ('backlash', 'drive_backlash')
 
@@ -179,7 +184,9 @@ def verdict(pv: Problem, model: Model) -> dict:
     """Whether the final model explains the validation data: its simulation error against what the
     encoders' rounding alone would leave (:func:`shooting.quantization_floor` of :func:`rounding_model`),
     on the cart and (with a pendulum) the angle. Explained when each is within EXPLAINED_FACTOR of its
-    floor plus EXPLAINED_SLACK counts."""
+    floor plus EXPLAINED_SLACK counts. The share of the motion left is the cart's, or the angle's where the
+    cart moves less than JUDGING_MOTION counts RMS within the validation windows (a pendulum swinging on
+    after the cart's last move): a block that hardly moves judges nothing, and the reason says so."""
     summ = pv.summary(model)
     out: dict = {}
     ok = True
@@ -187,19 +194,29 @@ def verdict(pv: Problem, model: Model) -> dict:
     for key, win, _ in pv.blocks:
         fl = shooting.quantization_floor(plain, pv.rec, win, key)
         out[key] = {'counts': summ[f'{key}_rms_counts'], 'percent': summ[f'{key}_percent'],
-                    'floor_counts': fl[f'{key}_floor_counts'], 'floor_percent': fl[f'{key}_floor_percent']}
+                    'floor_counts': fl[f'{key}_floor_counts'], 'floor_percent': fl[f'{key}_floor_percent'],
+                    'motion_counts': summ[f'{key}_motion_counts']}
         ok &= out[key]['counts'] <= EXPLAINED_FACTOR * out[key]['floor_counts'] + EXPLAINED_SLACK
-    x = out['x']
-    if ok:
-        reason = (f'explained: {x["percent"]:.3g} % of the motion is left, what the encoders\' rounding alone leaves '
-                  f'({x["floor_percent"]:.3g} %)')
+    moving = [k for k in out if out[k]['motion_counts'] >= JUDGING_MOTION]
+    head = moving[0] if moving else 'x'
+    h = out[head]
+    still = [f'the {NAMES[k]} moves {out[k]["motion_counts"]:.2g} counts RMS within the validation windows'
+             for k in out if k not in moving]
+    if not moving:
+        reason = (f'not judged: nothing moves by {JUDGING_MOTION:g} counts RMS within the validation windows ('
+                  + ', '.join(still) + '): these data can neither explain nor refute the model')
+    elif ok:
+        reason = (f'explained: {h["percent"]:.3g} % of {OF[head]} is left, what the encoders\' '
+                  f'rounding alone leaves ({h["floor_percent"]:.3g} %)')
     else:
-        worst = max(out, key=lambda k: out[k]['counts'] / max(out[k]['floor_counts'], 1e-9))
+        worst = max(moving, key=lambda k: out[k]['counts'] / max(out[k]['floor_counts'], 1e-9))
         w = out[worst]
-        reason = (f'not explained: {x["percent"]:.3g} % of the motion is left ({x["counts"]:.3g} counts RMS), where '
-                  f'the encoders\' rounding alone would leave {x["floor_percent"]:.3g} % ({x["floor_counts"]:.3g} '
-                  f'counts)' + ('' if worst == 'x' else f'; the angle: {w["percent"]:.3g} % left, '
-                                                        f'{w["floor_percent"]:.3g} % from rounding'))
-    return {'explained': bool(ok), 'unexplained_percent': x['percent'], 'floor_percent': x['floor_percent'],
-            'unexplained_counts': x['counts'], 'floor_counts': x['floor_counts'], 'reason': reason,
-            'blocks': out}
+        reason = (f'not explained: {h["percent"]:.3g} % of {OF[head]} is left ({h["counts"]:.3g} counts '
+                  f'RMS), where the encoders\' rounding alone would leave {h["floor_percent"]:.3g} % '
+                  f'({h["floor_counts"]:.3g} counts)' + ('' if worst == head else f'; the angle: {w["percent"]:.3g} % '
+                                                        f'left, {w["floor_percent"]:.3g} % from rounding'))
+    if still and moving:
+        reason += '; ' + ', '.join(still) + ': it judges nothing'
+    return {'explained': bool(ok) and bool(moving), 'unexplained_percent': h['percent'],
+            'floor_percent': h['floor_percent'], 'unexplained_counts': h['counts'], 'floor_counts': h['floor_counts'],
+            'judged_on': moving, 'reason': reason, 'blocks': out}

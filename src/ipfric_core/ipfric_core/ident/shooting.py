@@ -444,14 +444,16 @@ def reading_errors(pred: Prediction, rec: Record, key: str) -> np.ndarray:
 
 
 def summary(pred: Prediction, rec: Record, win: Windows, key: str) -> dict:
-    """RMS error of ``key`` in counts and in percent of the motion within the windows."""
+    """RMS error of ``key`` in counts and in percent of the motion within the windows; the motion's own RMS
+    [counts] (each reading from its window's first)."""
     c = pred.compared
     e = reading_errors(pred, rec, key)
     meas, res = (rec.x, rec.x_resolution) if key == 'x' else (rec.theta, rec.theta_resolution)
     assert meas is not None, f'no {key} in the record'
     motion = (meas[c] - meas[win.start[pred.window_of[c]]]) / res
     return {f'{key}_windows': len(win), f'{key}_rms_counts': float(np.sqrt(np.mean(e ** 2))),
-            f'{key}_percent': float(100 * np.linalg.norm(e) / max(float(np.linalg.norm(motion)), 1.0))}
+            f'{key}_percent': float(100 * np.linalg.norm(e) / max(float(np.linalg.norm(motion)), 1.0)),
+            f'{key}_motion_counts': float(np.sqrt(np.mean(motion ** 2)))}
 
 
 def window_sse(pred: Prediction, rec: Record, win: Windows, key: str) -> np.ndarray:
