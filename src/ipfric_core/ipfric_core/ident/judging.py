@@ -41,7 +41,8 @@ WORSE_COUNTS = 0.5       # and by more than this [counts RMS]: an angle error ne
 #: leaves, plus this many counts
 EXPLAINED_FACTOR = 1.5
 EXPLAINED_SLACK = 0.3
-#: a block of the validation data whose readings move less than this within its windows judges nothing [counts RMS]
+#: a block of the validation data whose readings move less than this within its windows gives no share of the
+#: motion left (its counts are still judged against its floor) [counts RMS]
 JUDGING_MOTION = 2.0
 NAMES = {'x': 'cart', 'theta': 'angle'}
 #: what the share left is of, by the block that judges
@@ -186,7 +187,8 @@ def verdict(pv: Problem, model: Model) -> dict:
     on the cart and (with a pendulum) the angle. Explained when each is within EXPLAINED_FACTOR of its
     floor plus EXPLAINED_SLACK counts. The share of the motion left is the cart's, or the angle's where the
     cart moves less than JUDGING_MOTION counts RMS within the validation windows (a pendulum swinging on
-    after the cart's last move): a block that hardly moves judges nothing, and the reason says so."""
+    after the cart's last move): the share of a block that hardly moves would say nothing, and the reason says
+    so; its error in counts is still judged against its floor."""
     summ = pv.summary(model)
     out: dict = {}
     ok = True
@@ -216,7 +218,7 @@ def verdict(pv: Problem, model: Model) -> dict:
                   f'({h["floor_counts"]:.3g} counts)' + ('' if worst == head else f'; the angle: {w["percent"]:.3g} % '
                                                         f'left, {w["floor_percent"]:.3g} % from rounding'))
     if still and moving:
-        reason += '; ' + ', '.join(still) + ': it judges nothing'
+        reason += '; ' + ', '.join(still) + ': no share of its motion is given (its counts are still judged)'
     return {'explained': bool(ok) and bool(moving), 'unexplained_percent': h['percent'],
             'floor_percent': h['floor_percent'], 'unexplained_counts': h['counts'], 'floor_counts': h['floor_counts'],
             'judged_on': moving, 'reason': reason, 'blocks': out}
