@@ -65,6 +65,9 @@ CASES = [
      '1 samples is too short; at least 200 are needed'),
     ('bag is text', {'b.mcap': b't,x,voltage\n0,0,1\n'}, ['analyze', '--no-plots', '{dir}/b.mcap'], 2,
      'not an MCAP file'),
+    *[(f'identify time limit {v}', {'b.csv': b't,x,voltage\n0,0,1\n'},
+       ['identify', '{dir}/b.csv', '--out', '{dir}/id', '--time-limit', v], 2,
+       f'--time-limit: {v} s; allowed a positive finite number of seconds') for v in ('0', '-5', 'nan', 'inf')],
 ]
 
 

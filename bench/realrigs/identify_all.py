@@ -25,14 +25,16 @@ HEADER = ('| rig / log | exit | wall s | kept (effects, corrections, law) | verd
           '| final Fc, Fs - Fc [N] | on a bound |\n| --- | --- | --- | --- | --- | --- | --- |')
 
 
-def identify(csv: Path, out: Path) -> dict:
+def identify(csv: Path, out: Path, time_limit: float | None = None) -> dict:
     """Run ``python -m ipfric_core.cli identify`` (``./ipfric identify``) on one log with this process's
     Python and environment, as the campaign does (the ipfric_core on its path: a worktree's where PYTHONPATH
-    names it), on one thread; its exit code, wall time and the reason of a refusal."""
+    names it), on one thread (with ``--time-limit`` where ``time_limit`` [s] is given); its exit code, wall
+    time and the reason of a refusal."""
     with csv.open() as f:
         cart_alone = 'theta' not in f.readline().strip().split(',')
     args = ['identify', str(csv), '--plant', str(csv.parent / 'plant.yaml'), '--out', str(out),
-            '--no-plots', '--json'] + (['--cart-alone'] if cart_alone else [])
+            '--no-plots', '--json'] + (['--cart-alone'] if cart_alone else []) + (
+                ['--time-limit', f'{time_limit:g}'] if time_limit is not None else [])
     t0 = time.perf_counter()
     proc = subprocess.run([sys.executable, '-m', 'ipfric_core.cli', *args], cwd=ROOT,
                           env=dict(os.environ, NUMBA_NUM_THREADS='1', OPENBLAS_NUM_THREADS='1', MKL_NUM_THREADS='1'),
@@ -67,7 +69,9 @@ def row(rig: str, log: str, run: dict, result: dict | None) -> dict:
     bound = ', '.join(n for n, p in params.items() if p['at_bound']) or 'none'
     return dict(out, kept=', '.join(kept) or 'none', friction=friction, bound=bound,
                 verdict=f'{"explained" if v["explained"] else "not explained"}: {v["unexplained_percent"]:.3g} % '
-                        f'({v["floor_percent"]:.2g} %)')
+                        f'({v["floor_percent"]:.2g} %)' + (f'; stopped before round {v["stopped"]["before_round"]} '
+                                                           f'(--time-limit {v["stopped"]["time_limit_s"]:g})'
+                                                           if 'stopped' in v else ''))
 
 
 def markdown(rows: list[dict]) -> str:
@@ -75,7 +79,8 @@ def markdown(rows: list[dict]) -> str:
                                  f'{r["verdict"]} | {r["friction"]} | {r["bound"]} |' for r in rows]) + '\n'
 
 
-def identify_all(data: Path, runs: Path, only: list[str] | None = None, resume: bool = False) -> list[dict]:
+def identify_all(data: Path, runs: Path, only: list[str] | None = None, resume: bool = False,
+                 time_limit: float | None = None) -> list[dict]:
     """Identify the logs of ``data`` (or those of ``only``) into ``runs``; the table's rows."""
     rows = []
     for rig, logs in LOGS.items():
@@ -87,7 +92,7 @@ def identify_all(data: Path, runs: Path, only: list[str] | None = None, resume: 
                 run = json.loads((out / 'run.json').read_text()) if (out / 'run.json').exists() else \
                     dict(exit=0, wall_s=float('nan'))
             else:
-                run = identify(csv, out)
+                run = identify(csv, out, time_limit)
             result = json.loads((out / 'result.json').read_text()) if run['exit'] == 0 else None
             rows.append(row(rig, log, run, result))
             print(markdown(rows[-1:]).split('\n')[-2] if len(rows) > 1 else markdown(rows).rstrip(), flush=True)
@@ -103,13 +108,15 @@ def main(argv=None) -> int:
     ap.add_argument('--out', required=True, type=Path, help='directory of the reports, table.md and rows.json')
     ap.add_argument('--only', help='comma-separated rig or rig/log names (default: every log of DATA)')
     ap.add_argument('--resume', action='store_true', help='skip the logs whose result.json exists')
+    ap.add_argument('--time-limit', type=float, metavar='SECONDS',
+                    help='identify\'s --time-limit for each log (default: none)')
     args = ap.parse_args(argv)
     only = args.only.split(',') if args.only else None
     if why := unknown_names(only):
         ap.error(why)
     if not (args.data / 'manifest.json').is_file():
         ap.error(f'{args.data}: no manifest.json; give the directory that bench.realrigs.convert --out wrote')
-    rows = identify_all(args.data.resolve(), args.out.resolve(), only, args.resume)
+    rows = identify_all(args.data.resolve(), args.out.resolve(), only, args.resume, args.time_limit)
     if not rows:
         ap.error(f'no converted log of {args.data} is among --only {args.only}')
     print(f'\n{markdown(rows)}{len(rows)} logs; table in {args.out / "table.md"}')

@@ -8,6 +8,7 @@ from independent import rigsim
 
 from ipfric_core.analysis.records import load
 from ipfric_core.ident.judging import rounding_model, verdict
+from ipfric_core.ident.ladder import run_ladder
 from ipfric_core.ident.model import load_declared
 from ipfric_core.ident.problem import Problem
 from ipfric_core.ident.shooting import quantization_floor
@@ -64,3 +65,18 @@ def test_a_validation_part_where_nothing_moves_judges_nothing(tmp_path):
     assert v['judged_on'] == [] and not v['explained']
     assert v['reason'].startswith('not judged: nothing moves by 2 counts RMS within the validation windows (the cart '
                                   'moves 0 counts RMS')
+
+
+@pytest.mark.slow
+def test_a_time_limit_stops_the_ladder_between_rounds_and_says_so(tmp_path):
+    """With a time limit that round 1 outlasts, round 1 runs whole and keeps its explanation, no round
+    follows, and the verdict says where the ladder stopped (a 30 ms real log whose dynamic law took hours
+    over four rounds: docs/identification.md)."""
+    rec = load(rigsim.write_case('cart_deadzone', tmp_path, duration=20.0), None)
+    est, val = rec.split(0.6)
+    res = run_ladder(est, val, load_declared(None, 'exponential', pendulum=False), time_limit=1e-3)
+    assert [r['round'] for r in res['rounds']] == [1] and res['rounds'][0]['kept'], res['rounds']
+    assert len(res['steps']) == 2 and {t['round'] for t in res['tried']} == {1}
+    v = res['verdict']
+    assert v['stopped']['before_round'] == 2 and v['stopped']['elapsed_s'] > v['stopped']['time_limit_s'] == 1e-3
+    assert 'stopped before round 2 of at most 4' in v['reason'] and 'the time limit is 0.001 s' in v['reason'], v

@@ -48,6 +48,8 @@ def add_arguments(i) -> None:
                    '(default %(default)s)')
     i.add_argument('--out', default='runs/identify', help='report directory (default %(default)s)')
     i.add_argument('--no-plots', action='store_true', help='no PNG figures')
+    i.add_argument('--time-limit', type=float, metavar='SECONDS', help='start no round of the ladder after the '
+                   'first once it has run this long; the verdict says where it stopped (default: no limit)')
     i.add_argument('--export', help='write the identified plant and the gain designed on it as a scenario YAML')
     i.add_argument('--scenario', default=str(DEFAULT_SCENARIO),
                    help='settings, Q and R for --export (default %(default)s)')
@@ -144,7 +146,8 @@ def main(args) -> int:
     say = None if args.json else (lambda msg: print(msg, file=sys.stderr))
     r = identify_record(args.data, args.out, args.plant, args.base, args.free, args.effects,
                         parse_columns(args.columns), args.cart_alone, args.validation, args.split,
-                        not args.no_plots, args.export, args.scenario, args.rig, say, args.test, args.test_init)
+                        not args.no_plots, args.export, args.scenario, args.rig, say, args.test, args.test_init,
+                        args.time_limit)
     if args.json:
         print_json(r)
         return 0

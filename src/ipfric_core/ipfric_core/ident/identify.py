@@ -12,6 +12,7 @@ and the identified rig exported as a scenario when asked.
 """
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from pathlib import Path
 
@@ -113,7 +114,7 @@ def identify_record(data: str | Path, out: str | Path, plant_file: str | Path | 
                     split: float = 0.6, plots: bool = True, export: str | Path | None = None,
                     scenario: str | Path | None = None, rig: str | Path | None = None,
                     progress: Callable[[str], None] | None = None, test: str | Path | None = None,
-                    test_init: int = INIT_SAMPLES) -> dict:
+                    test_init: int = INIT_SAMPLES, time_limit: float | None = None) -> dict:
     """Identify the record ``data`` (a bag or run directory, a CSV, an EMPS .mat) against the declared
     model of ``plant_file`` and write the report into ``out``; the result (``result.json``'s content).
 
@@ -121,7 +122,10 @@ def identify_record(data: str | Path, out: str | Path, plant_file: str | Path | 
     all); ``validation``: a second file to judge on, else the last 1 - ``split`` of ``data``'s motion;
     ``test``: a held-out file the final model runs free over from its first ``test_init`` readings;
     ``export``: write the identified rig as a scenario (settings, Q and R of ``scenario``; with ``rig``,
-    also that rig with the new gain)."""
+    also that rig with the new gain); ``time_limit`` [s]: no round of the ladder after the first starts
+    once it has run this long (:func:`~ipfric_core.ident.ladder.run_ladder`)."""
+    if time_limit is not None and not (math.isfinite(time_limit) and time_limit > 0):
+        raise ConfigError(f'--time-limit: {time_limit:g} s; allowed a positive finite number of seconds')
     allowed = candidate_effects(effects)
     plant, friction = read_declared(plant_file, base)
     rec = load(data, plant, columns, cart_alone)
@@ -136,7 +140,7 @@ def identify_record(data: str | Path, out: str | Path, plant_file: str | Path | 
         model = declared(plant or rec.plant or PlantParams(), friction, rec.theta is not None)
     if free:
         model = model.freeing([n.strip() for n in free.split(',')])
-    res = run_ladder(est, val, model, allowed, progress)
+    res = run_ladder(est, val, model, allowed, progress, time_limit)
     if force_input:
         balanced(res)
         res['force_error'] = force_errors(res)

@@ -25,6 +25,7 @@ standard errors from :mod:`ipfric_core.ident.problem`.
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass
 
 from ..analysis.records import Record
@@ -228,11 +229,19 @@ def viscous_note(declared: Model, model: Model) -> str:
     return f' (with {eps}: beta and eps act alike, the data fix beta + eps)'
 
 
-def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress=None) -> dict:
+def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress=None,
+               time_limit: float | None = None) -> dict:
     """The ladder on ``est`` (fits) and ``val`` (judgement): the declared model, then round by round the
     explanation that wins on validation among the competing hypotheses (:func:`hypotheses`), until the
-    data are explained down to the encoders' floor or nothing passes; see the module docstring."""
+    data are explained down to the encoders' floor or nothing passes; see the module docstring.
+
+    ``time_limit`` [s]: no round after the first starts once the ladder has run this long (a round is
+    never cut short); the verdict then says where it stopped (``stopped``). A round costs what its
+    hypotheses' simulations cost: one of the dynamic law's stiff bristles can cost a hundred of the
+    exponential law's (docs/identification.md, Known limits)."""
     say = progress or (lambda msg: None)
+    began = time.monotonic()
+    stopped = None
     pe, pv = Problem(est), Problem(val)
     current = declared
     steps = [Step('declared', declared.holding({p.name: p.value for p in declared.free}), {},
@@ -259,6 +268,11 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
     ps = pe.screen()
     balance = balance_starts(est, declared) if not declared.free else {}
     for round_no in range(1, MAX_ROUNDS + 1):
+        spent = time.monotonic() - began
+        if time_limit is not None and round_no > 1 and spent > time_limit:
+            stopped = {'before_round': round_no, 'time_limit_s': time_limit, 'elapsed_s': spent}
+            say(f'stopped before round {round_no}: {spent:.0f} s spent, the time limit is {time_limit:g} s')
+            break
         explained = verdict(pv, current)['explained']     # then only a kept effect's refinement is tried
         hs = refinements(pe, current) if explained else hypotheses(pe, current, declared, allowed, balance)
         if not hs:
@@ -322,7 +336,7 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
                        'runner_up': _alternative(runner, pv) if runner else None})
         say(f'kept {win.h.label}: validation x error {steps[-1].val["x_rms_counts"]:.3g} counts'
             + (f'; runner-up {runner.h.label} ({pv.summary(runner.model)["x_rms_counts"]:.3g} counts)'
-               if runner else ''))
+               if runner else '') + f' (round {round_no} ended at {time.monotonic() - began:.0f} s)')
     current = undo_corrections(pe, pv, declared, current, steps, say)
     current = drop_spent(pe, pv, declared, current, steps, say)
     v = verdict(pv, current)
@@ -332,6 +346,10 @@ def run_ladder(est: Record, val: Record, declared: Model, allowed=None, progress
         v['tried'] = sorted({t['hypothesis'] for t in tried})
         v['largest_left'] = [{'hypothesis': t['hypothesis'], 'validation_gain_percent': t['validation_gain_percent'],
                               'refused': t['refused']} for t in left[:3]]
+    if stopped:
+        v['stopped'] = stopped
+        v['reason'] += (f'; stopped before round {stopped["before_round"]} of at most {MAX_ROUNDS}: '
+                        f'{stopped["elapsed_s"]:.0f} s spent, the time limit is {time_limit:g} s')
     say(v['reason'])
     return {'steps': steps, 'tried': tried, 'rounds': rounds, 'verdict': v, 'estimation': est, 'validation': val}
 
