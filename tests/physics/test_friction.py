@@ -1,8 +1,16 @@
 import math
 
+import numpy as np
 import pytest
 
-from ipfric_core.physics.friction import Friction, friction_vector, sliding_friction, static_friction, stribeck_level
+from ipfric_core.physics.friction import (
+    Friction,
+    bristle_path,
+    friction_vector,
+    sliding_friction,
+    static_friction,
+    stribeck_level,
+)
 from ipfric_core.physics.params import FrictionParams
 
 FN = (0.815 + 0.21) * 9.8
@@ -70,6 +78,20 @@ def test_steady_sliding_friction_is_eq8_whatever_the_bristles_damping():
             assert sliding_friction(fp, v) == pytest.approx(-math.copysign(g, v) - 3.0 * v, rel=1e-12)
     fp = friction_vector(EXP, FN)
     assert sliding_friction(fp, 0.05) == pytest.approx(Friction(EXP, FN).force(0.05), rel=1e-12)
+
+
+def test_bristle_path_is_eq10_solved_exactly_and_holds_at_rest():
+    """The bristles along held velocities (the equation-error path's friction): eq. (10) at constant v is
+    z' = v - a z, a = sigma0 |v| / g(v), so z(t) = z_ss (1 - exp(-a t)) from rest, z_ss = g(v) sgn(v) / sigma0;
+    a zero velocity holds z."""
+    fp = friction_vector(DYN, FN)
+    v, dt = -0.02, 1e-3
+    g = (0.04287 + (0.0861 - 0.04287) * math.exp(-(abs(v) / 0.105) ** 2)) * FN
+    a, z_ss = 121.0 * abs(v) / g, -g / 121.0
+    z = bristle_path(fp, np.array([v] * 5 + [0.0] * 3), dt)
+    for k in range(5):
+        assert z[k] == pytest.approx(z_ss * (1.0 - math.exp(-a * dt * (k + 1))), rel=1e-12)
+    assert list(z[5:]) == [z[4]] * 3
 
 
 def test_dynamic_presliding_is_a_spring():

@@ -185,7 +185,7 @@ def bristle_path(fp, v, dt: float):
     """Bristle deflection z [m] along velocity samples ``v`` [m/s], each held for ``dt`` [s].
 
     Eq. (10) with v constant is linear in z, z' = v - a z with a = sigma0 |v| / g(v):
-    each step is integrated exactly, z -> z_ss + (z - z_ss) exp(-a dt), z_ss = v / a.
+    each step is integrated exactly, z -> z_ss + (z - z_ss) exp(-a dt), z_ss = :func:`steady_deflection`.
     Starts from z = 0; z holds while v = 0.
     """
     z = np.empty(len(v))
@@ -193,7 +193,7 @@ def bristle_path(fp, v, dt: float):
     for k in range(len(v)):
         if v[k] != 0.0:
             a = fp[FP_SIGMA0] * abs(v[k]) / bristle_level(fp, v[k])
-            zss = v[k] / a
+            zss = steady_deflection(fp, v[k])
             zk = zss + (zk - zss) * math.exp(-a * dt)
         z[k] = zk
     return z
