@@ -40,7 +40,8 @@ from .params import FrictionParams
 
 __all__ = ['DYNAMIC', 'FP_MODEL', 'FP_EPS', 'FP_SIGMA0', 'FP_SIGMA1', 'FP_ASYM', 'friction_vector', 'sticks',
            'static_limit', 'holding_margin', 'holds', 'sliding_level', 'bristle_level', 'friction_force',
-           'steady_deflection', 'sliding_friction', 'bristle_rate', 'friction_forces', 'bristle_path', 'Friction']
+           'steady_deflection', 'sliding_friction', 'bristle_relaxation', 'bristle_rate', 'friction_forces',
+           'bristle_path', 'Friction']
 
 #: Codes of the friction models in a parameter vector (floats, so the vector is uniform).
 MODEL_CODES = {'viscous': 0.0, 'coulomb': 1.0, 'exponential': 2.0, 'dynamic': 3.0}
@@ -126,6 +127,13 @@ def bristle_level(fp, v: float) -> float:
 
 
 @compiled
+def bristle_relaxation(fp, v: float) -> float:
+    """The bristles' relaxation rate a = sigma0 |v| / g(v) [1/s] of eq. (10) at speed ``v`` [m/s]
+    (z' = v - a z): how fast the deflection settles to :func:`steady_deflection`."""
+    return fp[FP_SIGMA0] * abs(v) / bristle_level(fp, v)
+
+
+@compiled
 def friction_force(fp, v: float, z: float, direction: float) -> float:
     """Friction force on the moving cart [N], eqs. (3), (6)-(8), (11).
 
@@ -192,7 +200,7 @@ def bristle_path(fp, v, dt: float):
     zk = 0.0
     for k in range(len(v)):
         if v[k] != 0.0:
-            a = fp[FP_SIGMA0] * abs(v[k]) / bristle_level(fp, v[k])
+            a = bristle_relaxation(fp, v[k])
             zss = steady_deflection(fp, v[k])
             zk = zss + (zk - zss) * math.exp(-a * dt)
         z[k] = zk

@@ -30,7 +30,7 @@ from .friction import (
     FP_MODEL,
     FP_SIGMA0,
     FP_SIGMA1,
-    bristle_level,
+    bristle_relaxation,
     friction_force,
     holding_margin,
     holds,
@@ -209,12 +209,13 @@ def _advance_hybrid(pp, fp, ef, s, mode, h, voltage):
 def bristle_step(pp, fp, v: float, h: float) -> float:
     """Largest RK4 step [s] of the dynamic law (eqs. 10-11) at speed ``v`` [m/s]: ``h``, CONTACT_STEPS
     per period 2 pi sqrt(M / sigma0) of the bristles' oscillation with the cart, and at most 1 over the
-    bristles' relaxation rate sigma0 |v| / g(v) and the damping rate (sigma1 + eps) / M (RK4 is stable
-    to 2.8 over a rate); no more than MAX_BRISTLE_STEPS steps in ``h``. ``h`` for the other laws."""
+    bristles' relaxation rate sigma0 |v| / g(v) (:func:`bristle_relaxation`) and the damping rate
+    (sigma1 + eps) / M (RK4 is stable to 2.8 over a rate); no more than MAX_BRISTLE_STEPS steps in ``h``.
+    ``h`` for the other laws."""
     if fp[FP_MODEL] != DYNAMIC:
         return h
     step = min(h, 2.0 * math.pi * math.sqrt(pp[0] / fp[FP_SIGMA0]) / CONTACT_STEPS)
-    rate = max(fp[FP_SIGMA0] * abs(v) / bristle_level(fp, v), (fp[FP_SIGMA1] + fp[FP_EPS]) / pp[0])
+    rate = max(bristle_relaxation(fp, v), (fp[FP_SIGMA1] + fp[FP_EPS]) / pp[0])
     if rate * step > 1.0:
         step = 1.0 / rate
     return max(step, h / MAX_BRISTLE_STEPS)
