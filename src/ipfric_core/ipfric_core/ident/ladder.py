@@ -45,7 +45,7 @@ from .hypotheses import (
 from .judging import WORSE_PERCENT, Judged, beyond_refit, contribution, drop_checks, judge, leaner_first, verdict
 from .model import FRICTION_FITTED, LAW_PARAMS, Model
 from .problem import Problem, fit_model
-from .refutations import CLOSED_PLAY, near, play_closed, uncorrected, unfit, unresolved, untold
+from .refutations import CLOSED_PLAY, near, play_closed, smallest_play, uncorrected, unfit, unresolved, untold
 from .starts import DRIVE_GRID, balance_starts
 
 __all__ = ['Step', 'run_ladder']
@@ -83,13 +83,14 @@ def confirm(pe: Problem, pv: Problem, current: Model, j: Judged, prior: Model) -
 
 
 def play_checks(pe: Problem, pv: Problem, j: Judged, prior: Model, size: list[str]) -> list[str]:
-    """A drive's play judged against the drive with its play closed (:func:`closed_play`), where its size
-    told from zero or not (``size``: :func:`unresolved`'s reasons) may be decided so (:func:`profiled`):
-    refused where the closed one replays the validation data better (the play a local minimum of the fit);
-    a play within two standard errors of zero told from zero by that profile (the report says so in
-    ``j.notes``) or, where it is not, refused with both reasons. A drive whose play is held closed (a
-    compliant contact without play, :func:`hypotheses.with_play_closed`) has no play to judge: the report
-    says what it is. Returns the reasons about its size."""
+    """A drive's play judged against the drive with its play closed (:func:`held_play` at CLOSED_PLAY), where
+    its size told from zero or not (``size``: :func:`unresolved`'s reasons) may be decided so
+    (:func:`profiled`): refused where the closed one replays the validation data better (the play a local
+    minimum of the fit); a play within two standard errors of zero told from zero by that profile (the report
+    says so in ``j.notes``) or, where it is not, refused with both reasons; then against the smallest play the
+    encoder shows (:func:`shown`). A drive whose play is held closed (a compliant contact without play,
+    :func:`hypotheses.with_play_closed`) has no play to judge: the report says what it is. Returns the reasons
+    about its size."""
     if play_closed(j.model):
         if not size:
             j.notes.append(f'a compliant drive without play: the motor side, {j.model["drive_mass_kg"]:.4g} kg, '
@@ -98,7 +99,7 @@ def play_checks(pe: Problem, pv: Problem, j: Judged, prior: Model, size: list[st
         return size
     if size and not profiled(j.model, j.std):
         return size
-    dropped, left, better = closed_play(pe, pv, j, prior)
+    dropped, left, better = held_play(pe, pv, j, prior, CLOSED_PLAY)
     here = pv.summary(j.model)['x_rms_counts']
     if better:
         return [f'the drive with its play closed (a compliant contact without play) replays the validation data '
@@ -111,12 +112,36 @@ def play_checks(pe: Problem, pv: Problem, j: Judged, prior: Model, size: list[st
                        f'{j.std["drive_backlash_m"] * 1e3:.2g} mm is within two standard errors of zero; its profile '
                        f'tells it from zero: the drive with its play closed leaves {left:.3g} counts on validation, '
                        f'against {here:.3g}')
-    return []
+    return shown(pe, pv, j, prior, here)
+
+
+def shown(pe: Problem, pv: Problem, j: Judged, prior: Model, here: float) -> list[str]:
+    """A drive's play within two standard errors of the smallest play the encoder shows (two counts,
+    :func:`refutations.smallest_play`: below, the readings' rounding) judged by its profile there
+    (:func:`held_play`): refused where the drive with its play held at two counts replays the validation data
+    as well by the rule an effect must pass (``here``: the drive's own validation error [counts]). Seed 2027's
+    case 188, a hanging pendulum, a play of 1.2 counts the encoder cannot show: the closed drive kept in round
+    1, its play opened in round 2 to 2.24 +/- 0.49 counts (1.38 counts on validation), which held at two counts
+    left 1.02; case 34, a play of 2.45 counts, opened to 3.15 +/- 1.9 counts (2.88), held at two 3.58, p = 0.2."""
+    low = smallest_play(pe.rec)
+    play, s = j.model['drive_backlash_m'], j.std.get('drive_backlash_m')
+    if s is not None and math.isfinite(s) and play - 2 * s > low:
+        return []
+    dropped, left, better = held_play(pe, pv, j, prior, low)
+    if not (dropped or better):
+        return []
+    err = f' +/- {s * 1e3:.2g}' if s is not None and math.isfinite(s) else ''
+    how = ('it replays them better, the fitted play a local minimum' if better else
+           f'its own play beyond it: {dropped[0]}')
+    return [f'drive play {play * 1e3:.3g}{err} mm is within two standard errors of two encoder counts '
+            f'({low * 1e3:.3g} mm, the smallest play the encoder shows); held there, the drive leaves {left:.3g} '
+            f'counts on validation against {here:.3g}: {how}; the data do not tell the play from one the encoder '
+            'cannot show']
 
 
 def profiled(model: Model, std: dict) -> bool:
     """Whether a drive's play within two standard errors of zero is decided by its profile
-    (:func:`closed_play`): where the scan along it confined it and the motor side is told from zero. Not
+    (:func:`held_play` at CLOSED_PLAY): where the scan along it confined it and the motor side is told from zero. Not
     where the data fix neither: the ENME303 PD log `app1_acf60_pd2` (three validation windows) was given
     a drive with 6.0 +/- 6 kg on its motor side and a 2.5 +/- 2.5 mm play not confined below, which the
     profile alone would have kept."""
@@ -125,24 +150,24 @@ def profiled(model: Model, std: dict) -> bool:
             and model['drive_mass_kg'] > 2 * s)
 
 
-def closed_play(pe: Problem, pv: Problem, j: Judged, prior: Model) -> tuple[list[str], float, bool]:
-    """A drive against itself with its play closed: fitted again with the play held at CLOSED_PLAY (a
-    compliant contact without play), the rest of its parameters free. Returns why its play does not lower
-    the validation error beyond the closed one's by the rule an effect must pass (:func:`drop_checks`;
-    empty where it does), the validation error the closed play leaves [counts], and whether the closed one
-    lowers it beyond the drive's by that rule: then the fitted play is a local minimum, the data show a
-    contact without play. A play within two standard errors of zero (:func:`unresolved`) is decided by it:
-    the Jacobian's errors assume a quadratic valley, and the play and the contact's stiffness trade along a
-    curved one (seed 2027's case 191, a 0.046 mm play in place of an alpha correction on the cart alone: the
-    play 0.024 +/- 0.020 mm; with it closed the validation error rose from 2.47 counts to 4.57). Seed 2027's
-    cases 71 and 106, a motor side behind plays of 0.5 and 0.25 counts, were answered with drives of 0.43 and
-    0.20 mm; closed, their validation errors fell from 25.4 counts to 1.76 and from 8.78 to 0.59."""
+def held_play(pe: Problem, pv: Problem, j: Judged, prior: Model, play: float) -> tuple[list[str], float, bool]:
+    """A drive against itself with its play held at ``play`` [m]: fitted again so, the rest of its parameters
+    free (at CLOSED_PLAY: a compliant contact without play). Returns why its own play does not lower the
+    validation error beyond the held one's by the rule an effect must pass (:func:`drop_checks`; empty where
+    it does), the validation error the held play leaves [counts], and whether the held one lowers it beyond
+    the drive's by that rule: then the fitted play is a local minimum. A play within two standard errors of
+    zero (:func:`unresolved`) is decided by it held closed: the Jacobian's errors assume a quadratic valley,
+    and the play and the contact's stiffness trade along a curved one (seed 2027's case 191, a 0.046 mm play
+    in place of an alpha correction on the cart alone: the play 0.024 +/- 0.020 mm; with it closed the
+    validation error rose from 2.47 counts to 4.57). Seed 2027's cases 71 and 106, a motor side behind plays
+    of 0.5 and 0.25 counts, were answered with drives of 0.43 and 0.20 mm; closed, their validation errors
+    fell from 25.4 counts to 1.76 and from 8.78 to 0.59."""
     name = 'drive_backlash_m'
-    closed = fit_model(pe, j.model.holding({name: CLOSED_PLAY}), only=joint(j.h, j.model) - {name}, prior=prior,
-                       errors=False)[0]
-    *_, dropped = drop_checks(pv, closed, j.model, pv.window_sse(closed), j.p_max)
-    *_, worse = drop_checks(pv, j.model, closed, pv.window_sse(j.model))
-    return dropped, pv.summary(closed)['x_rms_counts'], not worse
+    held = fit_model(pe, j.model.holding({name: play}), only=joint(j.h, j.model) - {name}, prior=prior,
+                     errors=False)[0]
+    *_, dropped = drop_checks(pv, held, j.model, pv.window_sse(held), j.p_max)
+    *_, worse = drop_checks(pv, j.model, held, pv.window_sse(j.model))
+    return dropped, pv.summary(held)['x_rms_counts'], not worse
 
 
 def as_refit(pe: Problem, pv: Problem, current: Model, j: Judged, prior: Model, sse0_v) -> Judged:
