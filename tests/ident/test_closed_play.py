@@ -36,19 +36,37 @@ def drive(declared, gap, mass, freq, zeta, law):
          'drive_damping_Ns_per_m': 2 * zeta * (k * reduced) ** 0.5, **law}).with_free(OWN + LAW)
 
 
-@pytest.mark.slow
-def test_a_play_of_four_counts_is_told_from_zero_by_its_profile(tmp_path):
-    """Seed 2027, case 191: the cart alone, a 0.046 mm play (4.1 counts of 0.011 mm) with 0.457 kg on the
-    motor side, its contact at 183 Hz. The drive at the generator's values: closed, the play's absence
-    costs more than the rule allows on validation, and the closed drive leaves far more than the true one."""
-    campaign.generate(tmp_path, 0, 2027, indices=[191])
-    d = tmp_path / campaign.case_name(191)
+def clean_cart(tmp_path):
+    """A clean cart of the independent simulator (30 s): its record, the estimation and validation parts, the
+    declared model and the simulator's true friction law."""
+    rec = load(rigsim.write_case('cart_none', tmp_path, duration=30.0), None, cart_alone=True)
+    truth = rigsim.RIGS['quanser']
+    fn = truth['M'] * truth['g']
+    law = {'Fc': truth['mu_c'] * fn, 'Fs_excess': (truth['mu_s'] - truth['mu_c']) * fn, 'eps': truth['eps'],
+           'v_s': truth['v_s']}
+    return (rec, *rec.split(0.6), load_declared(None, 'exponential', False), law)
+
+
+def true_drive(tmp_path, index):
+    """Seed 2027's campaign case ``index`` on the cart alone (a drive with play): its estimation and validation
+    parts, the declared model, the drive at the generator's values and its play [m]."""
+    campaign.generate(tmp_path, 0, 2027, indices=[index])
+    d = tmp_path / campaign.case_name(index)
     truth = json.loads((d / 'truth.json').read_text())
     e, f = truth['effects']['drive_backlash'], truth['friction']
     est, val = load(d / 'data.csv', PlantParams(**truth['constants']), None, True).split(0.6)
     declared = load_declared(None, 'exponential', False, PlantParams(**truth['constants']))
     model = drive(declared, e['gap_m'], e['motor_mass_kg'], e['contact_frequency_Hz'], e['damping_ratio'],
                   {n: f[n] for n in LAW})
+    return est, val, declared, model, e['gap_m']
+
+
+@pytest.mark.slow
+def test_a_play_of_four_counts_is_told_from_zero_by_its_profile(tmp_path):
+    """Seed 2027, case 191: the cart alone, a 0.046 mm play (4.1 counts of 0.011 mm) with 0.457 kg on the
+    motor side, its contact at 183 Hz. The drive at the generator's values: closed, the play's absence
+    costs more than the rule allows on validation, and the closed drive leaves far more than the true one."""
+    est, val, declared, model, _ = true_drive(tmp_path, 191)
     pv = Problem(val)
     dropped, left, better = held_play(Problem(est), pv, judged(model), declared, CLOSED_PLAY)
     assert dropped == [] and not better
@@ -59,13 +77,7 @@ def test_a_play_the_data_do_not_have_is_not_told_from_zero(tmp_path):
     """A clean cart of the independent simulator (30 s) given a drive: 0.1 kg of its mass on a motor side
     behind a play of two encoder counts, a stiff contact. Closed, the play changes nothing the validation
     rule can see: the reason names it; and the closed drive, refitted, replays the data better."""
-    rec = load(rigsim.write_case('cart_none', tmp_path, duration=30.0), None, cart_alone=True)
-    est, val = rec.split(0.6)
-    declared = load_declared(None, 'exponential', False)
-    truth = rigsim.RIGS['quanser']
-    fn = truth['M'] * truth['g']
-    law = {'Fc': truth['mu_c'] * fn, 'Fs_excess': (truth['mu_s'] - truth['mu_c']) * fn, 'eps': truth['eps'],
-           'v_s': truth['v_s']}
+    rec, est, val, declared, law = clean_cart(tmp_path)
     model = drive(declared.with_values({'M': declared['M'] - 0.1}), 2 * rec.x_resolution, 0.1, 200.0, 0.15, law)
     dropped, left, better = held_play(Problem(est), Problem(val), judged(model), declared, CLOSED_PLAY)
     assert len(dropped) == 1 and 'validation error drops by' in dropped[0]
@@ -79,13 +91,7 @@ def test_a_play_not_told_from_two_counts_is_refused_where_the_data_show_none(tmp
     side: with a standard error of 0.5 count the play is within two of two counts, and held there it replays
     the validation data as well, so it is refused; with an error of 0.1 count the play is told from two
     counts by its error alone and no profile is fitted."""
-    rec = load(rigsim.write_case('cart_none', tmp_path, duration=30.0), None, cart_alone=True)
-    est, val = rec.split(0.6)
-    declared = load_declared(None, 'exponential', False)
-    truth = rigsim.RIGS['quanser']
-    fn = truth['M'] * truth['g']
-    law = {'Fc': truth['mu_c'] * fn, 'Fs_excess': (truth['mu_s'] - truth['mu_c']) * fn, 'eps': truth['eps'],
-           'v_s': truth['v_s']}
+    rec, est, val, declared, law = clean_cart(tmp_path)
     count = rec.x_resolution
     model = drive(declared.with_values({'M': declared['M'] - 0.1}), 2.5 * count, 0.1, 200.0, 0.15, law)
     pe, pv = Problem(est), Problem(val)
@@ -106,18 +112,11 @@ def test_a_play_of_eight_counts_is_told_from_two_counts_by_its_profile(tmp_path)
     counts): held at two counts, refitted, the drive replays the validation data worse by the rule an effect
     must pass, and the play is kept. (Case 191's 4.1 counts, given the 0.020 mm the Jacobian once put on its
     play, are not told from two counts so: p = 0.016 over 37 windows; its ladder finds 0.0028 mm.)"""
-    campaign.generate(tmp_path, 0, 2027, indices=[59])
-    d = tmp_path / campaign.case_name(59)
-    truth = json.loads((d / 'truth.json').read_text())
-    e, f = truth['effects']['drive_backlash'], truth['friction']
-    est, val = load(d / 'data.csv', PlantParams(**truth['constants']), None, True).split(0.6)
-    assert e['gap_m'] == pytest.approx(8.0 * est.x_resolution, rel=0.01)
-    declared = load_declared(None, 'exponential', False, PlantParams(**truth['constants']))
-    model = drive(declared, e['gap_m'], e['motor_mass_kg'], e['contact_frequency_Hz'], e['damping_ratio'],
-                  {n: f[n] for n in LAW})
+    est, val, declared, model, gap = true_drive(tmp_path, 59)
+    assert gap == pytest.approx(8.0 * est.x_resolution, rel=0.01)
     pv = Problem(val)
     j = judged(model)
-    j.std = Errors(['drive_backlash_m'], np.diag([e['gap_m']]) ** 2)
+    j.std = Errors(['drive_backlash_m'], np.diag([gap]) ** 2)
     assert shown(Problem(est), pv, j, declared, pv.summary(model)['x_rms_counts']) == []
 
 
@@ -143,13 +142,7 @@ def test_a_closed_play_is_opened_even_where_the_data_are_explained(tmp_path):
     from ipfric_core.ident.hypotheses import refinements
     from ipfric_core.ident.judging import verdict
     from ipfric_core.ident.ladder import run_ladder
-    rec = load(rigsim.write_case('cart_none', tmp_path, duration=30.0), None, cart_alone=True)
-    est, val = rec.split(0.6)
-    truth = rigsim.RIGS['quanser']
-    fn = truth['M'] * truth['g']
-    law = {'Fc': truth['mu_c'] * fn, 'Fs_excess': (truth['mu_s'] - truth['mu_c']) * fn, 'eps': truth['eps'],
-           'v_s': truth['v_s']}
-    base = load_declared(None, 'exponential', False)
+    rec, est, val, base, law = clean_cart(tmp_path)
     closed = drive(base.with_values({'M': base['M'] - 0.1}), CLOSED_PLAY, 0.1, 200.0, 0.15, law)
     closed = closed.holding({p.name: p.value for p in closed.params})
     assert verdict(Problem(val), closed)['explained']
